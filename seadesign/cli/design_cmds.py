@@ -1,0 +1,1 @@
+"""Design-side subcommands: geometry, export, sweep."""

@@ -1,0 +1,17 @@
+"""Errors that carry a message meant for the user (the CLI prints them without a traceback)."""
+
+
+class SeadesignError(Exception):
+    """Base class: the message names the file/field and says how to fix it."""
+
+
+class ConfigError(SeadesignError):
+    """A study or material file is invalid."""
+
+
+class SpringFileError(SeadesignError):
+    """A spring.json handoff file is missing, unreadable or fails its schema."""
+
+
+class DataError(SeadesignError):
+    """A recording or bench file is malformed."""

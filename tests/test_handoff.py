@@ -1,0 +1,45 @@
+"""spring.json schema: valid files pass, each kind of defect is refused with the field named."""
+
+import json
+
+import pytest
+
+from seadesign.errors import SpringFileError
+from seadesign.handoff import load_spring, validate_spring, write_spring
+
+
+def test_valid_spring_round_trips(spring_file, spring_dict):
+    assert load_spring(spring_file) == json.loads(json.dumps(spring_dict))
+
+
+@pytest.mark.parametrize(
+    "mutate, field",
+    [
+        (lambda d: d.pop("k_Nm_per_rad"), "k_Nm_per_rad"),
+        (lambda d: d.update(k_Nm_per_rad=-1.0), "k_Nm_per_rad"),
+        (lambda d: d.update(k_Nm_per_rad="9.1"), "k_Nm_per_rad"),
+        (lambda d: d["material"].update(poisson_ratio=0.5), "material/poisson_ratio"),
+        (lambda d: d.update(surprise=1), r"\(top level\)"),
+        (lambda d: d["actuator"].pop("gear_ratio"), "actuator/gear_ratio"),
+    ],
+)
+def test_bad_spring_names_the_field(spring_dict, mutate, field):
+    mutate(spring_dict)
+    with pytest.raises(SpringFileError, match=f"field '{field}'"):
+        validate_spring(spring_dict)
+
+
+def test_writer_refuses_invalid(tmp_path, spring_dict):
+    spring_dict["k_source"] = "guessed"
+    with pytest.raises(SpringFileError, match="k_source"):
+        write_spring(spring_dict, tmp_path / "s.json")
+    assert not (tmp_path / "s.json").exists()
+
+
+def test_missing_and_malformed_files(tmp_path):
+    with pytest.raises(SpringFileError, match="does not exist"):
+        load_spring(tmp_path / "nope.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(SpringFileError, match="not valid JSON"):
+        load_spring(bad)
