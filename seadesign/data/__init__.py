@@ -1,0 +1,24 @@
+"""Measured data: the robot recording and bench formats, artefact detection and cleaning.
+
+Public API (stable):
+
+- `read_recording(path) -> DataFrame`, `write_recording(df, path, metadata=None)`: the
+  robot format (`robot.py`, columns in `RECORDING_COLUMNS`).
+- `read_bench(path) -> DataFrame`, `write_bench(df, path, metadata=None)`: the bench format
+  `time_s, torque_Nm, deflection_rad[, temperature_C]` (`bench.py`).
+- `read_metadata(csv_path)`, `write_metadata(csv_path, dict)`: the `<name>.meta.json` sidecar.
+- `detect_artefacts(df) -> ArtefactReport` (`artefacts.py`).
+- `clean(df, ...) -> CleanResult` with the cleaned table and the step log (`cleaning.py`).
+
+Every malformed input raises `seadesign.errors.DataError` naming line, row and column.
+"""
+
+from seadesign.data.bench import BENCH_OPTIONAL, BENCH_REQUIRED, read_bench, write_bench
+from seadesign.data.metadata import read_metadata, sidecar_path, write_metadata
+from seadesign.data.robot import KNEE_SIGN, KNEES, RECORDING_COLUMNS, read_recording, write_recording
+
+__all__ = [
+    "BENCH_OPTIONAL", "BENCH_REQUIRED", "KNEES", "KNEE_SIGN", "RECORDING_COLUMNS",
+    "read_bench", "read_metadata", "read_recording", "sidecar_path", "write_bench",
+    "write_metadata", "write_recording",
+]
