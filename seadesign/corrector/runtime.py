@@ -1,0 +1,95 @@
+"""Correctors as run in a control loop: one call per knee and step, target in, motor command out.
+
+All correctors share `command(knee, target_rad, measured, dt_s) -> command_rad`, where
+`measured` holds the knee's channels at this step (names of `modalities.MODALITIES`, robot
+frame, SI). `reset()` clears internal state between trials.
+
+- `NoCorrection`: command = target.
+- `HallPI`: the thesis's PI on the Hall error e = target - hall (kp 0.2, ki 0.1 by default).
+- `FeedForward`: command = target + effort / k (adds the deflection a linear spring of
+  stiffness k shows under the measured torque).
+- `NetCorrector`: a trained network (NumPy path of an exported bundle).
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from seadesign.corrector.dataset import KNEES, DatasetSpec, FeatureBuilder
+from seadesign.corrector.export import NumpyCorrector
+from seadesign.errors import SeadesignError
+
+
+class Corrector(Protocol):
+    """What the open- and closed-loop evaluations drive."""
+
+    name: str
+
+    def reset(self) -> None: ...
+
+    def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float) -> float: ...
+
+
+class NoCorrection:
+    """Send the target unchanged."""
+
+    def __init__(self, name: str = "none") -> None:
+        self.name = name
+
+    def reset(self) -> None:
+        """Nothing to reset."""
+
+    def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float) -> float:
+        return target_rad
+
+
+class HallPI:
+    """PI on the Hall error: command = target + kp e + ki integral(e dt), e = target - hall (rad)."""
+
+    def __init__(self, kp: float = 0.2, ki: float = 0.1, name: str = "pi") -> None:
+        self.kp, self.ki, self.name = kp, ki, name
+        self._integral = {k: 0.0 for k in KNEES}
+
+    def reset(self) -> None:
+        self._integral = {k: 0.0 for k in KNEES}
+
+    def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float) -> float:
+        e = target_rad - measured["hall_pos_rad"]
+        self._integral[knee] += e * dt_s
+        return target_rad + self.kp * e + self.ki * self._integral[knee]
+
+
+class FeedForward:
+    """Physics feed-forward: command = target + effort / k (k in Nm/rad from spring.json)."""
+
+    def __init__(self, k_Nm_per_rad: float, name: str = "feedforward") -> None:
+        if k_Nm_per_rad <= 0:
+            raise SeadesignError(f"k_Nm_per_rad must be > 0, got {k_Nm_per_rad}")
+        self.k, self.name = k_Nm_per_rad, name
+
+    def reset(self) -> None:
+        """Stateless."""
+
+    def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float) -> float:
+        return target_rad + measured["effort_Nm"] / self.k
+
+
+class NetCorrector:
+    """A trained network driven online; builds its inputs exactly as the training dataset did."""
+
+    def __init__(self, model: NumpyCorrector, spec: DatasetSpec, name: str) -> None:
+        self.model, self.spec, self.name = model, spec, name
+        self.reset()
+
+    def reset(self) -> None:
+        self._builders = {k: FeatureBuilder(self.spec, k) for k in KNEES}
+
+    def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float) -> float:
+        b = self._builders[knee]
+        b.push(measured)
+        x = b.inputs(target_rad)
+        if self.model.siamese:  # x_t: measured state; x_t+1: the target with this step's channels (thesis 6.2.3)
+            x = np.concatenate([b.state(), x])
+        return b.unmirror(float(self.model(x)))
