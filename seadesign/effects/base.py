@@ -1,0 +1,238 @@
+"""The effect abstraction: one physical effect, its parameters, and one forward model used two ways.
+
+An `Effect` reads named signals and returns a new value for one signal (`writes`). Signals
+are numpy arrays with time on the last axis (any leading batch axes). Signal names and units
+are listed in `SIGNALS`; an instance may bind its roles to other signal names (`bind`), so the
+same dead-band can act on a bench deflection or a robot deflection, and friction can act on
+the link or on the motor side.
+
+Two uses of the same object:
+
+- fitting / post-processing: `apply(signals, params)` maps whole recorded arrays at once;
+- time stepping (the simulators): `init_state(sample, params)` then `step(state, sample, dt,
+  params, rng)` once per time step on arrays of the batch shape.
+
+Both give the same result (tested for every effect). Parameters are `Param` records with a
+unit, a default and physical bounds; `params` arguments are mappings name -> value that
+override the instance's values, so a fitter can pass trial values without copying objects.
+Additive effects add to the current value of their target (zero when the signal is absent).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar, Mapping
+
+import numpy as np
+
+from seadesign.errors import ConfigError
+
+Signals = Mapping[str, np.ndarray]
+
+#: Signal vocabulary: name -> (unit, meaning). Rotations: knee flexion positive.
+SIGNALS: dict[str, tuple[str, str]] = {
+    "time": ("s", "sample time"),
+    "deflection": ("rad", "deflection of the torque path: motor output minus link angle"),
+    "torque": ("Nm", "torque the spring transmits to the link"),
+    "angle": ("rad", "link (knee) angle"),
+    "velocity": ("rad/s", "link angular velocity"),
+    "load_torque": ("Nm", "torque the link needs from the spring beyond inertia (gravity, contact, friction)"),
+    "stance": ("1", "1 while the foot carries body weight, else 0"),
+    "hall": ("rad", "Hall sensor reading of the link angle"),
+    "motor": ("rad", "motor encoder reading"),
+    "motor_velocity": ("rad/s", "motor output angular velocity"),
+    "effort": ("Nm", "torque the servo reports (from its current)"),
+    "temperature": ("degC", "measured spring temperature (optional)"),
+}
+
+
+@dataclass(frozen=True)
+class Param:
+    """A parameter: name, unit, default, physical bounds [lower, upper], meaning."""
+
+    name: str
+    unit: str
+    default: float
+    lower: float
+    upper: float
+    doc: str
+
+
+class Effect:
+    """Base class; subclasses set the class attributes and implement `_map` or the stateful trio."""
+
+    key: ClassVar[str]
+    summary: ClassVar[str]
+    parameters: ClassVar[tuple[Param, ...]] = ()
+    reads: ClassVar[tuple[str, ...]] = ()
+    writes: ClassVar[str]
+    stateful: ClassVar[bool] = False
+    random: ClassVar[bool] = False
+
+    def __init__(self, name: str | None = None, *, enabled: bool = True,
+                 bind: Mapping[str, str] | None = None, **values: float) -> None:
+        self.name = name or self.key
+        self.enabled = enabled
+        self.bind = dict(bind or {})
+        unknown_roles = set(self.bind) - set(self.reads) - {self.writes}
+        if unknown_roles:
+            raise ConfigError(f"effect '{self.name}': cannot bind {sorted(unknown_roles)}; roles are {self.roles()}")
+        self.values = {p.name: float(p.default) for p in self.parameters}
+        self.values.update(self._check(values))
+
+    # -- parameters -------------------------------------------------------------------
+    def _check(self, values: Mapping[str, float]) -> dict[str, float]:
+        known = {p.name: p for p in self.parameters}
+        out = {}
+        for name, value in values.items():
+            if name not in known:
+                raise ConfigError(
+                    f"effect '{self.name}' has no parameter '{name}'; parameters: {', '.join(known) or 'none'}"
+                )
+            p = known[name]
+            value = float(value)
+            if not (p.lower <= value <= p.upper):
+                raise ConfigError(
+                    f"effect '{self.name}': {name} = {value} {p.unit} is outside its physical bounds "
+                    f"[{p.lower}, {p.upper}] {p.unit}"
+                )
+            out[name] = value
+        return out
+
+    def resolve(self, params: Mapping[str, float] | None = None) -> dict[str, float]:
+        """Instance values overridden by `params` (checked against names and bounds)."""
+        return {**self.values, **self._check(params or {})}
+
+    def replace(self, *, enabled: bool | None = None, **values: float) -> "Effect":
+        """A copy with some values (and/or the on/off switch) changed."""
+        return type(self)(self.name, enabled=self.enabled if enabled is None else enabled,
+                          bind=self.bind, **{**self.values, **values})
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds in the order of `parameters`."""
+        return (np.array([p.lower for p in self.parameters]), np.array([p.upper for p in self.parameters]))
+
+    # -- signals ----------------------------------------------------------------------
+    def roles(self) -> tuple[str, ...]:
+        return tuple(dict.fromkeys((*self.reads, self.writes)))
+
+    def signal(self, role: str) -> str:
+        """The signal name a role is bound to."""
+        return self.bind.get(role, role)
+
+    def target(self) -> str:
+        """The signal this effect writes."""
+        return self.signal(self.writes)
+
+    def _inputs(self, signals: Signals, like: np.ndarray | None = None) -> dict[str, np.ndarray]:
+        out = {}
+        for role in self.roles():
+            name = self.signal(role)
+            if name in signals:
+                out[role] = np.asarray(signals[name], dtype=float)
+            elif role == self.writes:
+                out[role] = None  # filled below with zeros
+            else:
+                raise ConfigError(
+                    f"effect '{self.name}' needs signal '{name}' (role {role}, {SIGNALS.get(role, ('?', ''))[0]}); "
+                    f"available: {', '.join(signals)}"
+                )
+        if out.get(self.writes) is None:
+            ref = next(v for v in out.values() if v is not None) if like is None else like
+            out[self.writes] = np.zeros_like(ref, dtype=float)
+        return out
+
+    # -- forward models ---------------------------------------------------------------
+    def apply(self, signals: Signals, params: Mapping[str, float] | None = None,
+              rng: np.random.Generator | None = None) -> np.ndarray:
+        """New value of the target signal over whole arrays (time on the last axis)."""
+        p = self.resolve(params)
+        x = self._inputs(signals)
+        if not self.stateful:
+            return self._map(x, p, _rng(rng))
+        return self._apply_stateful(x, p)
+
+    def init_state(self, sample: Signals, params: Mapping[str, float] | None = None) -> dict[str, Any]:
+        """State before the first step, from the first sample (batch-shaped arrays)."""
+        return self._init(self._inputs(sample), self.resolve(params)) if self.stateful else {}
+
+    def step(self, state: dict[str, Any], sample: Signals, dt: float,
+             params: Mapping[str, float] | None = None, rng: np.random.Generator | None = None) -> np.ndarray:
+        """New value of the target at one time step of length dt (s); updates `state` in place."""
+        p = self.resolve(params)
+        x = self._inputs(sample)
+        if not self.stateful:
+            return self._map(x, p, _rng(rng))
+        return self._advance(state, x, dt, p)
+
+    def _map(self, x: dict[str, np.ndarray], p: dict[str, float], rng: np.random.Generator) -> np.ndarray:
+        raise NotImplementedError(f"{type(self).__name__} is stateful; use step or apply")
+
+    def _init(self, x: dict[str, np.ndarray], p: dict[str, float]) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def _advance(self, state: dict[str, Any], x: dict[str, np.ndarray], dt: float, p: dict[str, float]) -> np.ndarray:
+        raise NotImplementedError
+
+    def _apply_stateful(self, x: dict[str, np.ndarray], p: dict[str, float]) -> np.ndarray:
+        raise NotImplementedError
+
+    # -- description ------------------------------------------------------------------
+    def describe(self) -> dict[str, Any]:
+        """JSON-ready description (for a simulated file's metadata)."""
+        return {
+            "name": self.name,
+            "effect": self.key,
+            "enabled": self.enabled,
+            "summary": self.summary,
+            "reads": [self.signal(r) for r in self.reads],
+            "writes": self.target(),
+            "parameters": {
+                p.name: {"value": self.values[p.name], "unit": p.unit, "bounds": [p.lower, p.upper], "doc": p.doc}
+                for p in self.parameters
+            },
+        }
+
+    def __repr__(self) -> str:
+        vals = ", ".join(f"{k}={v:g}" for k, v in self.values.items())
+        state = "" if self.enabled else ", off"
+        return f"{type(self).__name__}({self.name!r}{', ' if vals else ''}{vals}{state})"
+
+
+def _rng(rng: np.random.Generator | None) -> np.random.Generator:
+    return rng if rng is not None else np.random.default_rng(0)
+
+
+def time_steps(time: np.ndarray) -> np.ndarray:
+    """dt per sample (s) along the last axis; the first sample gets dt = 0."""
+    time = np.asarray(time, dtype=float)
+    dt = np.diff(time, axis=-1, prepend=time[..., :1])
+    return dt
+
+
+def rows(*arrays: np.ndarray) -> list[tuple[list[float], ...]]:
+    """Broadcast arrays, flatten leading axes, and return per-row Python lists (fast scalar loops)."""
+    b = np.broadcast_arrays(*arrays)
+    n = b[0].shape[-1]
+    flat = [a.reshape(-1, n) for a in b]
+    return [tuple(f[i].tolist() for f in flat) for i in range(flat[0].shape[0])]
+
+
+def lowpass(x: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
+    """First-order lag y' = (x - y) / tau (tau s) along the last axis, y starting at x[..., 0].
+
+    Discretised exactly for x held over each step: y_n = y_{n-1} + (x_n - y_{n-1})(1 - exp(-dt_n/tau)).
+    """
+    x = np.asarray(x, dtype=float)
+    shape = np.broadcast_shapes(x.shape, np.shape(time))
+    out = np.empty(shape)
+    out_rows = out.reshape(-1, shape[-1])
+    for i, (xs, dts) in enumerate(rows(x, time_steps(time))):
+        y = xs[0]
+        ys = []
+        for xv, dt in zip(xs, dts):
+            y += (xv - y) * (1.0 - math.exp(-dt / tau))
+            ys.append(y)
+        out_rows[i] = ys
+    return out

@@ -1,0 +1,73 @@
+"""Loads on the link: torque the link needs from the spring beyond its inertia.
+
+Convention: J angle'' = spring torque - load_torque, knee flexion positive. Each effect adds
+its share to `load_torque`; bound to other signals (e.g. `effort`, `motor_velocity`) the same
+objects model gearbox friction or a bench's friction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from seadesign.effects.base import Effect, Param
+
+G = 9.81  # m/s^2
+
+
+class Friction(Effect):
+    """Coulomb + viscous friction: load += Fc tanh(v / vs) + Fv v (tanh: a smooth sign)."""
+
+    key = "friction"
+    summary = "load += Fc tanh(v/vs) + Fv v"
+    parameters = (
+        Param("coulomb_Nm", "Nm", 0.05, 0.0, 20.0, "Coulomb friction torque Fc"),
+        Param("viscous_Nm_s_per_rad", "Nm s/rad", 0.02, 0.0, 50.0, "viscous coefficient Fv"),
+        Param("smoothing_rad_per_s", "rad/s", 0.05, 1e-5, 10.0, "velocity vs below which the Coulomb term fades"),
+    )
+    reads = ("velocity",)
+    writes = "load_torque"
+
+    def _map(self, x, p, rng):
+        v = x["velocity"]
+        return x["load_torque"] + p["coulomb_Nm"] * np.tanh(v / p["smoothing_rad_per_s"]) + p["viscous_Nm_s_per_rad"] * v
+
+
+class GravityLoad(Effect):
+    """Gravity on the hanging lower leg: load += A sin(angle + phi), A = m g l_c."""
+
+    key = "gravity"
+    summary = "load += A sin(angle + phi)"
+    parameters = (
+        Param("amplitude_Nm", "Nm", 0.6, 0.0, 100.0, "m g l_c of the lower leg and foot"),
+        Param("angle_offset_rad", "rad", 0.0, -np.pi, np.pi, "angle phi at which the leg hangs straight down, negated"),
+    )
+    reads = ("angle",)
+    writes = "load_torque"
+
+    def _map(self, x, p, rng):
+        return x["load_torque"] + p["amplitude_Nm"] * np.sin(x["angle"] + p["angle_offset_rad"])
+
+
+class StanceLoad(Effect):
+    """Body weight on a bent leg in stance: load -= W l2 sin(a2), hip above ankle.
+
+    With thigh l1 and shank l2 and knee angle q, the shank leans a2 from vertical with
+    tan a2 = l1 sin q / (l2 + l1 cos q); the weight share W (N) then flexes the knee with
+    W l2 sin a2. Acts only where `stance` is 1.
+    """
+
+    key = "ground_contact"
+    summary = "stance: load -= W l2 sin(a2(angle)), weight W on a hip-over-ankle leg"
+    parameters = (
+        Param("weight_N", "N", 0.5 * 8.0 * G, 0.0, 2000.0, "weight share W the stance leg carries"),
+        Param("upper_leg_m", "m", 0.2, 0.01, 2.0, "thigh length l1"),
+        Param("lower_leg_m", "m", 0.2038, 0.01, 2.0, "shank length l2"),
+    )
+    reads = ("angle", "stance")
+    writes = "load_torque"
+
+    def _map(self, x, p, rng):
+        q = x["angle"]
+        l1, l2 = p["upper_leg_m"], p["lower_leg_m"]
+        lean = np.arctan2(l1 * np.sin(q), l2 + l1 * np.cos(q))
+        return x["load_torque"] - x["stance"] * p["weight_N"] * l2 * np.sin(lean)
