@@ -10,6 +10,7 @@ plain NumPy path with the same outputs. A bundle directory holds:
 
 import json
 import platform
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -130,8 +131,10 @@ def export_bundle(net: CorrectorNet, meta: dict[str, Any], out_dir: str | Path) 
     units = [unit_of(n.split("[")[0]) for n in names]
     meta = {**meta, "input_units": units, "versions": versions()}
     text = json.dumps(meta, indent=2, default=_json_default)
-    scripted = torch.jit.script(_Exported(net.cpu().eval(), names, units))
-    torch.jit.save(scripted, str(out / "corrector.pt"), _extra_files={"meta.json": text})
+    with warnings.catch_warnings():  # TorchScript is deprecated upstream but is the requested format
+        warnings.simplefilter("ignore", DeprecationWarning)
+        scripted = torch.jit.script(_Exported(net.cpu().eval(), names, units))
+        torch.jit.save(scripted, str(out / "corrector.pt"), _extra_files={"meta.json": text})
     np.savez(out / "corrector.npz", **numpy_arrays(net))
     (out / "meta.json").write_text(text + "\n")
     return out
@@ -161,5 +164,7 @@ def load_numpy(bundle: str | Path) -> NumpyCorrector:
 
 def load_torchscript(bundle: str | Path, freeze: bool = True) -> torch.jit.ScriptModule:
     """The TorchScript module of a bundle; frozen (faster single-sample calls) unless freeze=False."""
-    mod = torch.jit.load(str(Path(bundle) / "corrector.pt"), map_location="cpu").eval()
-    return torch.jit.freeze(mod, preserved_attrs=["input_names", "input_units"]) if freeze else mod
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        mod = torch.jit.load(str(Path(bundle) / "corrector.pt"), map_location="cpu").eval()
+        return torch.jit.freeze(mod, preserved_attrs=["input_names", "input_units"]) if freeze else mod
