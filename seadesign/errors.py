@@ -15,3 +15,11 @@ class SpringFileError(SeadesignError):
 
 class DataError(SeadesignError):
     """A recording or bench file is malformed."""
+
+
+class MeshError(SeadesignError):
+    """Meshing failed or produced a mesh that cannot be used (named setting and fix in the message)."""
+
+
+class SolverError(SeadesignError):
+    """A finite-element solve failed or its inputs are invalid."""
