@@ -38,7 +38,7 @@ SIGNALS: dict[str, tuple[str, str]] = {
     "angle": ("rad", "link (knee) angle"),
     "velocity": ("rad/s", "link angular velocity"),
     "load_torque": ("Nm", "torque the link needs from the spring beyond inertia (gravity, contact, friction)"),
-    "stance": ("1", "1 while the foot carries body weight, else 0"),
+    "stance": ("1", "share of the supported body weight this leg carries (0 in swing)"),
     "hall": ("rad", "Hall sensor reading of the link angle"),
     "motor": ("rad", "motor encoder reading"),
     "motor_velocity": ("rad/s", "motor output angular velocity"),
@@ -159,8 +159,11 @@ class Effect:
 
     def step(self, state: dict[str, Any], sample: Signals, dt: float,
              params: Mapping[str, float] | None = None, rng: np.random.Generator | None = None) -> np.ndarray:
-        """New value of the target at one time step of length dt (s); updates `state` in place."""
-        p = self.resolve(params)
+        """New value of the target at one time step of length dt (s); updates `state` in place.
+
+        With `params=None` the instance's values are used unchecked (the fast path for simulators).
+        """
+        p = self.values if params is None else self.resolve(params)
         x = self._inputs(sample)
         if not self.stateful:
             return self._map(x, p, _rng(rng))

@@ -79,16 +79,21 @@ class EffectChain:
         params = params or {}
         states: dict[str, dict[str, Any]] = {}
         for e in self._selected(targets):
-            states[e.name] = {"state": e.init_state(sample, params.get(e.name)) if e.stateful else {},
-                              "rng": effect_rng(seed, e.name) if e.random else None,
-                              "params": e.resolve(params.get(e.name))}
+            bound = e.replace(**params[e.name]) if e.name in params else e
+            states[e.name] = {"effect": bound,
+                              "state": bound.init_state(sample) if e.stateful else {},
+                              "rng": effect_rng(seed, e.name) if e.random else None}
         return states
 
     def step(self, states: dict[str, dict[str, Any]], sample: dict[str, np.ndarray], target: str, dt: float) -> np.ndarray:
         """Advance every started effect writing `target` by one step; updates `sample[target]` and returns it."""
-        for e in self.effects:
-            slot = states.get(e.name)
-            if slot is None or e.target() != target:
-                continue
-            sample[target] = e.step(slot["state"], sample, dt, slot["params"], slot["rng"])
+        for slot in states.values():
+            e = slot["effect"]
+            if e.target() == target:
+                sample[target] = e.step(slot["state"], sample, dt, None, slot["rng"])
         return sample[target]
+
+    @staticmethod
+    def stage(states: dict[str, dict[str, Any]], target: str) -> list[tuple[Any, dict[str, Any], Any]]:
+        """(effect, state, rng) of the started effects writing `target`, in order: for tight loops."""
+        return [(s["effect"], s["state"], s["rng"]) for s in states.values() if s["effect"].target() == target]

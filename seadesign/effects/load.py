@@ -53,13 +53,13 @@ class StanceLoad(Effect):
 
     With thigh l1 and shank l2 and knee angle q, the shank leans a2 from vertical with
     tan a2 = l1 sin q / (l2 + l1 cos q); the weight share W (N) then flexes the knee with
-    W l2 sin a2. Acts only where `stance` is 1.
+    W l2 sin a2, scaled by the leg's share `stance` of the weight (0 in swing).
     """
 
     key = "ground_contact"
     summary = "stance: load -= W l2 sin(a2(angle)), weight W on a hip-over-ankle leg"
     parameters = (
-        Param("weight_N", "N", 0.5 * 8.0 * G, 0.0, 2000.0, "weight share W the stance leg carries"),
+        Param("weight_N", "N", 0.5 * 8.0 * G, 0.0, 2000.0, "supported body weight W (on both legs together)"),
         Param("upper_leg_m", "m", 0.2, 0.01, 2.0, "thigh length l1"),
         Param("lower_leg_m", "m", 0.2038, 0.01, 2.0, "shank length l2"),
     )
