@@ -1,0 +1,253 @@
+"""The compliant element as a CadQuery solid, built from named parameters (all lengths mm).
+
+Shape (Bit-Bots family, DOMAIN.md): a hub (radius `hub_radius_mm`) and an outer ring joined
+by N equally spaced beams of one handedness. Each beam is an "S" of two opposed circular arcs
+of centreline radius `arc_radius_mm` and constant width `beam_thickness_mm`: the first arc is
+centred on the hub circle, the second on the ring's inner circle, and they are tangent half
+way, so the ring's inner radius is hub_radius + 2 arc_radius. Beams are clipped to the gap
+between hub and ring. Fillets of `fillet_radius_mm` round the beam roots; bolt holes (with
+optional counterbores), a central bore and optional radial nut slots are cut afterwards.
+
+Part frame: axis +z through the origin, the part spans z in [0, thickness_mm], the first
+beam's arc centres lie on the ray at `first_beam_angle_deg` from +x.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import cadquery as cq
+import numpy as np
+
+from seadesign.part import Hole, Interfaces
+
+
+@dataclass(frozen=True)
+class BoltPattern:
+    """`count` through holes on a circle, axial; optional counterbore from the top face (z = thickness)."""
+
+    count: int
+    circle_diameter_mm: float
+    hole_diameter_mm: float
+    start_angle_deg: float = 0.0
+    counterbore_diameter_mm: float = 0.0  # 0: none
+    counterbore_depth_mm: float = 0.0
+
+    def holes(self) -> tuple[Hole, ...]:
+        r = self.circle_diameter_mm / 2
+        return tuple(
+            Hole(r * math.cos(a), r * math.sin(a), self.hole_diameter_mm / 2)
+            for a in (math.radians(self.start_angle_deg) + 2 * math.pi * i / self.count for i in range(self.count))
+        )
+
+
+@dataclass(frozen=True)
+class NutSlots:
+    """Radial slots through the ring at each ring bolt, for captive nuts (mm)."""
+
+    width_mm: float  # tangential width (nut across flats plus clearance)
+    z_min_mm: float
+    z_max_mm: float
+
+
+@dataclass(frozen=True)
+class GeometryParams:
+    """Every dimension of one candidate (mm, deg)."""
+
+    beam_count: int
+    beam_thickness_mm: float  # in-plane width of a beam
+    hub_radius_mm: float
+    arc_radius_mm: float  # centreline radius of each of a beam's two arcs
+    ring_width_mm: float  # radial width of the outer ring
+    thickness_mm: float  # axial thickness of the part
+    first_beam_angle_deg: float
+    clockwise: bool  # handedness of the S (as seen from +z, the first arc turns clockwise)
+    fillet_radius_mm: float  # at the beam roots; 0 = sharp
+    hub_bolts: BoltPattern
+    ring_bolts: BoltPattern
+    bore_radius_mm: float = 0.0  # plain central bore; see bore_profile_mm
+    bore_profile_mm: tuple[tuple[float, float], ...] = field(default=())  # (z, r) points of a revolved bore
+    nut_slots: NutSlots | None = None
+
+    @property
+    def ring_inner_radius_mm(self) -> float:
+        return self.hub_radius_mm + 2 * self.arc_radius_mm
+
+    @property
+    def ring_outer_radius_mm(self) -> float:
+        return self.ring_inner_radius_mm + self.ring_width_mm
+
+    def bore_radius_between(self, z0_mm: float, z1_mm: float) -> float:
+        """Largest central-bore radius over z0 <= z <= z1 (mm)."""
+        radius = self.bore_radius_mm
+        if self.bore_profile_mm:
+            zs = [z for z, _ in self.bore_profile_mm]
+            rs = [r for _, r in self.bore_profile_mm]
+            inside = [r for z, r in self.bore_profile_mm if z0_mm <= z <= z1_mm]
+            ends = [float(np.interp(z, zs, rs, left=0.0, right=0.0)) for z in (z0_mm, z1_mm)]
+            radius = max([radius] + inside + ends)
+        return radius
+
+    def interfaces(self) -> Interfaces:
+        bore = self.bore_radius_between(0.0, self.thickness_mm)
+        return Interfaces(
+            hub_holes=self.hub_bolts.holes(),
+            ring_holes=self.ring_bolts.holes(),
+            bore_radius_mm=bore,
+            hub_radius_mm=self.hub_radius_mm,
+            ring_inner_radius_mm=self.ring_inner_radius_mm,
+            ring_outer_radius_mm=self.ring_outer_radius_mm,
+            thickness_mm=self.thickness_mm,
+        )
+
+
+@dataclass
+class Part:
+    """A built candidate: the solid plus the pieces the validity checks look at."""
+
+    params: GeometryParams
+    solid: cq.Solid | None  # None when the construction itself failed
+    beams: list[cq.Face]  # each beam's clipped 2D region (z = 0)
+    profile: cq.Face | None  # 2D profile before holes, after fillets
+    raw_profile: cq.Face | None  # 2D profile before fillets
+    errors: list[str]  # construction failures (each is an invalidity reason)
+
+    @property
+    def interfaces(self) -> Interfaces:
+        return self.params.interfaces()
+
+    @property
+    def volume_mm3(self) -> float:
+        return self.solid.Volume() if self.solid is not None else float("nan")
+
+
+def _disk(r: float, center: tuple[float, float] = (0.0, 0.0)) -> cq.Face:
+    return cq.Face.makeFromWires(cq.Wire.makeCircle(r, cq.Vector(*center, 0), cq.Vector(0, 0, 1)))
+
+
+def _annulus(r_in: float, r_out: float, center: tuple[float, float] = (0.0, 0.0)) -> cq.Face:
+    c = cq.Vector(*center, 0)
+    n = cq.Vector(0, 0, 1)
+    return cq.Face.makeFromWires(cq.Wire.makeCircle(r_out, c, n), [cq.Wire.makeCircle(r_in, c, n)])
+
+
+def _half_plane(upper: bool, size: float) -> cq.Face:
+    y0, y1 = (0.0, size) if upper else (-size, 0.0)
+    pts = [cq.Vector(-size, y0, 0), cq.Vector(size, y0, 0), cq.Vector(size, y1, 0), cq.Vector(-size, y1, 0)]
+    return cq.Face.makeFromWires(cq.Wire.makePolygon(pts, close=True))
+
+
+def _only_face(shape: cq.Shape) -> cq.Face:
+    faces = shape.Faces()
+    if len(faces) != 1:
+        raise ValueError(f"expected one face, got {len(faces)}")
+    return faces[0]
+
+
+def beam_face(p: GeometryParams, index: int) -> cq.Face:
+    """The 2D region of beam `index` (z = 0), clipped to the gap between hub and ring."""
+    r_h, r_arc, half_w = p.hub_radius_mm, p.arc_radius_mm, p.beam_thickness_mm / 2
+    big = 4 * p.ring_outer_radius_mm
+    first_up = not p.clockwise
+    arc1 = _annulus(r_arc - half_w, r_arc + half_w, (r_h, 0.0)).intersect(_half_plane(first_up, big))
+    arc2 = _annulus(r_arc - half_w, r_arc + half_w, (r_h + 2 * r_arc, 0.0)).intersect(_half_plane(not first_up, big))
+    # Reach a little into hub and ring so that the union overlaps instead of touching.
+    overlap = min(0.5, 0.25 * p.ring_width_mm, 0.25 * r_h)
+    clip = _annulus(r_h - overlap, p.ring_inner_radius_mm + overlap)
+    beam = _only_face(arc1.fuse(arc2).clean().intersect(clip))
+    angle = p.first_beam_angle_deg + 360.0 * index / p.beam_count
+    return beam.rotate(cq.Vector(0, 0, 0), cq.Vector(0, 0, 1), angle)
+
+
+class _RootVertices(cq.selectors.Selector):
+    """Vertices on the hub circle or the ring's inner circle: where beams meet the rings."""
+
+    def __init__(self, radii: tuple[float, ...], tol: float) -> None:
+        self.radii, self.tol = radii, tol
+
+    def filter(self, objectList):  # noqa: D102 (CadQuery selector protocol)
+        out = []
+        for v in objectList:
+            r = math.hypot(v.X, v.Y)
+            if any(abs(r - ri) < self.tol for ri in self.radii):
+                out.append(v)
+        return out
+
+
+def build_profile(p: GeometryParams) -> tuple[list[cq.Face], cq.Face]:
+    """The beams and the unfilleted profile face (z = 0, no holes)."""
+    beams = [beam_face(p, i) for i in range(p.beam_count)]
+    shape = _annulus(p.ring_inner_radius_mm, p.ring_outer_radius_mm).fuse(_disk(p.hub_radius_mm), *beams).clean()
+    return beams, _only_face(shape)
+
+
+def fillet_roots(p: GeometryParams, raw: cq.Face) -> cq.Face:
+    """Round the corners where beams meet the hub and the ring by `fillet_radius_mm`.
+
+    Each gap between beams is filleted as its own simple face (its root corners are convex
+    there), then the profile is rebuilt from the outer wire and the rounded gaps.
+    """
+    if p.fillet_radius_mm <= 0:
+        return raw
+    roots = _RootVertices((p.hub_radius_mm, p.ring_inner_radius_mm), 1e-3)
+    gaps = []
+    for wire in raw.innerWires():
+        rounded = cq.Sketch().face(cq.Face.makeFromWires(wire)).vertices(roots).fillet(p.fillet_radius_mm)
+        gaps.append(_only_face(rounded._faces).outerWire())
+    profile = cq.Face.makeFromWires(raw.outerWire(), gaps)
+    if not profile.isValid():
+        raise ValueError("the filleted profile is not a valid face")
+    return profile
+
+
+def _cutters(p: GeometryParams) -> list[cq.Solid]:
+    """Solids removed from the extruded profile: bolt holes, counterbores, bore, nut slots."""
+    t = p.thickness_mm
+    cut: list[cq.Solid] = []
+    for pattern in (p.hub_bolts, p.ring_bolts):
+        for h in pattern.holes():
+            cut.append(cq.Solid.makeCylinder(h.radius_mm, t + 2, cq.Vector(h.x_mm, h.y_mm, -1)))
+            if pattern.counterbore_diameter_mm > 0:
+                depth = pattern.counterbore_depth_mm
+                base = cq.Vector(h.x_mm, h.y_mm, t - depth)
+                cut.append(cq.Solid.makeCylinder(pattern.counterbore_diameter_mm / 2, depth + 1, base))
+    if p.bore_radius_mm > 0:
+        cut.append(cq.Solid.makeCylinder(p.bore_radius_mm, t + 2, cq.Vector(0, 0, -1)))
+    if p.bore_profile_mm:
+        pts = [(0.0, z) for z, _ in (p.bore_profile_mm[0],)] + [(r, z) for z, r in p.bore_profile_mm]
+        pts.append((0.0, p.bore_profile_mm[-1][0]))
+        wire = cq.Wire.makePolygon([cq.Vector(x, 0, z) for x, z in pts], close=True)
+        cut.append(cq.Solid.revolve(cq.Face.makeFromWires(wire), 360, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1)))
+    if p.nut_slots is not None:
+        s = p.nut_slots
+        length = p.ring_width_mm + 2.0
+        for h in p.ring_bolts.holes():
+            angle = math.degrees(math.atan2(h.y_mm, h.x_mm))
+            box = cq.Solid.makeBox(length, s.width_mm, s.z_max_mm - s.z_min_mm,
+                                   cq.Vector(p.ring_inner_radius_mm - 1.0, -s.width_mm / 2, s.z_min_mm))
+            cut.append(box.rotate(cq.Vector(0, 0, 0), cq.Vector(0, 0, 1), angle))
+    return cut
+
+
+def build_part(p: GeometryParams) -> Part:
+    """Build the candidate's solid. Construction failures are recorded as reasons, not raised."""
+    # OCC failures surface as assorted exception types, hence the broad excepts.
+    try:
+        beams, raw = build_profile(p)
+    except Exception as exc:
+        return Part(p, None, [], None, None, [f"the beams and rings do not fuse into one profile ({exc})"])
+    try:
+        profile = fillet_roots(p, raw)
+    except Exception as exc:
+        return Part(p, None, beams, None, raw, [f"the {p.fillet_radius_mm:g} mm beam-root fillets cannot be made "
+                                                f"(corners too close or too sharp: {exc})"])
+    try:
+        solid = cq.Solid.extrudeLinear(profile, cq.Vector(0, 0, p.thickness_mm))
+        cutters = _cutters(p)
+        if cutters:
+            solid = solid.cut(*cutters).clean()
+    except Exception as exc:
+        return Part(p, None, beams, profile, raw, [f"cutting holes, bore or slots failed ({exc})"])
+    solids = solid.Solids()
+    return Part(p, solids[0] if len(solids) == 1 else solid, beams, profile, raw, [])
