@@ -109,8 +109,8 @@ class Part:
     params: GeometryParams
     solid: cq.Solid | None  # None when the construction itself failed
     beams: list[cq.Face]  # each beam's clipped 2D region (z = 0)
-    profile: cq.Face | None  # 2D profile before holes, after fillets
-    raw_profile: cq.Face | None  # 2D profile before fillets
+    profile: cq.Shape | None  # 2D profile before holes, after fillets (a Face when beams join hub and ring)
+    raw_profile: cq.Shape | None  # 2D profile before fillets
     errors: list[str]  # construction failures (each is an invalidity reason)
 
     @property
@@ -175,11 +175,12 @@ class _RootVertices(cq.selectors.Selector):
         return out
 
 
-def build_profile(p: GeometryParams) -> tuple[list[cq.Face], cq.Face]:
-    """The beams and the unfilleted profile face (z = 0, no holes)."""
+def build_profile(p: GeometryParams) -> tuple[list[cq.Face], cq.Shape]:
+    """The beams and the unfilleted profile (z = 0, no holes): one face, or with no beams
+    the hub and ring as two faces."""
     beams = [beam_face(p, i) for i in range(p.beam_count)]
     shape = _annulus(p.ring_inner_radius_mm, p.ring_outer_radius_mm).fuse(_disk(p.hub_radius_mm), *beams).clean()
-    return beams, _only_face(shape)
+    return beams, (_only_face(shape) if beams else shape)
 
 
 def fillet_roots(p: GeometryParams, raw: cq.Face) -> cq.Face:
@@ -188,7 +189,7 @@ def fillet_roots(p: GeometryParams, raw: cq.Face) -> cq.Face:
     Each gap between beams is filleted as its own simple face (its root corners are convex
     there), then the profile is rebuilt from the outer wire and the rounded gaps.
     """
-    if p.fillet_radius_mm <= 0:
+    if p.fillet_radius_mm <= 0 or p.beam_count == 0:
         return raw
     roots = _RootVertices((p.hub_radius_mm, p.ring_inner_radius_mm), 1e-3)
     gaps = []
@@ -243,7 +244,8 @@ def build_part(p: GeometryParams) -> Part:
         return Part(p, None, beams, None, raw, [f"the {p.fillet_radius_mm:g} mm beam-root fillets cannot be made "
                                                 f"(corners too close or too sharp: {exc})"])
     try:
-        solid = cq.Solid.extrudeLinear(profile, cq.Vector(0, 0, p.thickness_mm))
+        pieces = [cq.Solid.extrudeLinear(f, cq.Vector(0, 0, p.thickness_mm)) for f in profile.Faces()]
+        solid = pieces[0] if len(pieces) == 1 else cq.Compound.makeCompound(pieces)
         cutters = _cutters(p)
         if cutters:
             solid = solid.cut(*cutters).clean()

@@ -34,7 +34,7 @@ def _wire_polygon(wire: cq.Wire, step_mm: float = 0.05) -> np.ndarray:
 
 def _gaps(part: Part) -> list[Polygon]:
     """The openings between beams in the (hole-free) profile, as polygons."""
-    return [Polygon(_wire_polygon(w)) for w in part.profile.innerWires()]
+    return [Polygon(_wire_polygon(w)) for face in part.profile.Faces() for w in face.innerWires()]
 
 
 def beam_clearance_mm(part: Part) -> float:

@@ -1,0 +1,69 @@
+"""Material files: the shipped ones load in SI; bad files are refused naming file and field."""
+
+from pathlib import Path
+
+import pytest
+
+from seadesign.errors import ConfigError
+from seadesign.materials import MATERIALS_DIR, load_material, load_material_file
+
+GOOD = """
+name = "Test TPU"
+youngs_modulus = { value = 12.0, unit = "MPa", source = "test" }
+poisson_ratio = { value = 0.48, unit = "-", source = "test" }
+density = { value = 1.19, unit = "g/cc", source = "test" }
+yield_strength = { value = 4.0, unit = "MPa", source = "test" }
+tensile_strength = { value = 26.0, unit = "MPa", source = "test" }
+"""
+
+
+def test_shipped_materials_load_in_si():
+    names = sorted(p.stem for p in MATERIALS_DIR.glob("*.toml"))
+    assert {"ninjaflex", "cheetah", "pla", "brass", "generic_tpu"} <= set(names)
+    nf = load_material("ninjaflex")
+    assert nf.youngs_modulus_Pa == pytest.approx(12e6)
+    assert nf.density_kg_per_m3 == pytest.approx(1190.0)
+    assert load_material("generic_tpu").youngs_modulus_Pa == pytest.approx(0.147e9)
+    # the thesis's brass typo (1096 GPa) is fixed
+    assert 100e9 <= load_material("brass").youngs_modulus_Pa <= 110e9
+    for name in names:
+        m = load_material(name)
+        assert 0 <= m.poisson_ratio < 0.5
+        assert all(src for _, src in m.sources)
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda t: t.replace('poisson_ratio = { value = 0.48', 'poisson_ratio = { value = 0.5'), "poisson_ratio.value"),
+        (lambda t: t.replace('value = 12.0', 'value = "twelve"'), "youngs_modulus.value must be a number"),
+        (lambda t: t.replace('unit = "MPa", source = "test" }\npoisson', 'unit = "psi", source = "test" }\npoisson'),
+         "youngs_modulus.unit"),
+        (lambda t: t.replace('value = 12.0, unit = "MPa"', 'value = 12.0, unit = "Pa"'), "physical range"),
+        (lambda t: t.replace('density = { value = 1.19, unit = "g/cc", source = "test" }\n', ''), "density is missing"),
+        (lambda t: t + 'colour = "red"\n', "colour is not a known key"),
+        (lambda t: t.replace(', source = "test" }\ndensity', ' }\ndensity'), "poisson_ratio.source is missing"),
+    ],
+)
+def test_bad_material_files_are_refused(tmp_path, edit, message):
+    path = _write(tmp_path, edit(GOOD))
+    with pytest.raises(ConfigError) as err:
+        load_material_file(path)
+    assert str(path) in str(err.value)
+    assert message in str(err.value)
+
+
+def test_unknown_material_lists_known():
+    with pytest.raises(ConfigError, match="known materials: .*ninjaflex"):
+        load_material("unobtainium")
+
+
+def test_toml_syntax_error(tmp_path):
+    with pytest.raises(ConfigError, match="not valid TOML"):
+        load_material_file(_write(tmp_path, "name = "))

@@ -1,0 +1,68 @@
+"""Study files: the default study's derived inputs, and refusal of bad files by key."""
+
+import math
+import re
+from pathlib import Path
+
+import pytest
+
+from seadesign.errors import ConfigError
+from seadesign.study import DEFAULT_STUDY, load_study
+
+
+def test_default_study():
+    s = load_study()
+    assert s.name == "wolfgang_knee"
+    assert len(s.candidates()) == 24
+    assert {(c.beam_count, c.beam_thickness_mm) for c in s.candidates()} == {
+        (n, t) for n in range(3, 11) for t in (4.0, 6.0, 8.0)}
+    # thesis eq. 5.1: tau = r F sin(theta) = 0.2038 m * 4 * 39.23 N * sin 60 deg = 27.70 Nm
+    assert s.load_cases.impact_torque_Nm == pytest.approx(0.2038 * 4 * 39.23 * math.sin(math.pi / 3))
+    assert round(s.load_cases.impact_torque_Nm, 2) == 27.70
+    assert s.base["hub_radius_mm"] == 14.0
+    hub = s.base["hub_bolts"]
+    assert (hub.count, hub.circle_diameter_mm) == (8, 22.0)
+
+
+def test_bitbots_study_loads():
+    s = load_study("bitbots_shoulder")
+    (p,) = s.candidates()
+    assert (p.beam_count, p.beam_thickness_mm, p.ring_outer_radius_mm) == (6, 3.0, 25.0)
+
+
+def _variant(tmp_path: Path, old: str, new: str) -> Path:
+    text = DEFAULT_STUDY.read_text()
+    assert re.search(old, text, flags=re.M), old
+    path = tmp_path / "variant.toml"
+    path.write_text(re.sub(old, new, text, count=1, flags=re.M))
+    return path
+
+
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        (r"^hub_radius_mm = 14.0", "hub_radius_mm = -3.0", "geometry.hub_radius_mm must be > 0"),
+        (r"^beam_count = \[3, 4, 5, 6, 7, 8, 9, 10\]", "beam_count = [0, 3]", r"design_space.beam_count\[0\] must be > 0"),
+        (r"^beam_count = \[3, 4, 5, 6, 7, 8, 9, 10\]", "beam_count = [3.5]", r"design_space.beam_count\[0\] must be one of the integers"),
+        (r"^thickness_mm = 9.0", 'thickness_mm = "nine"', "geometry.thickness_mm must be a number"),
+        (r"^thickness_mm = 9.0", "thickness_mm = 9.0\nthikness_mm = 9.0", "geometry.thikness_mm is not a known key"),
+        (r"^stall_torque_Nm = 11.7.*$", "", "load_cases.stall_torque_Nm is missing"),
+        (r"^material = .*$", 'material = "unobtainium"', "material cannot be loaded"),
+        (r"^circle_diameter_mm = 56.0", "circle_diameter_mm = 40.0", "geometry.ring_bolts.circle_diameter_mm puts the holes"),
+        (r"^bore_radius_mm = 4.0", "bore_radius_mm = 15.0", "geometry.bore_radius_mm"),
+        (r"^beam_thickness_mm = \[4.0, 6.0, 8.0\]", "beam_thickness_mm = [4.0, 12.0]",
+         "design_space.beam_thickness_mm value 12 mm needs geometry.arc_radius_mm > 6 mm"),
+        (r"^safety_factor = 1.5", "safety_factor = 0.5", "ranking.safety_factor must be >= 1"),
+    ],
+)
+def test_bad_study_is_refused_naming_the_key(tmp_path, old, new, message):
+    path = _variant(tmp_path, old, new)
+    with pytest.raises(ConfigError) as err:
+        load_study(path)
+    assert re.search(message, str(err.value)), str(err.value)
+    assert str(path) in str(err.value)
+
+
+def test_unknown_study_lists_known():
+    with pytest.raises(ConfigError, match="known studies: .*wolfgang_knee"):
+        load_study("nonexistent_study")
