@@ -22,12 +22,14 @@ Steps, in order (each can be switched off; every removed row is counted by reaso
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from seadesign.data.artefacts import Thresholds, detect_artefacts
+from seadesign.data.metadata import write_metadata
 from seadesign.data.robot import KNEE_SIGN, KNEES, PRESSURE_COLUMNS, check_recording_frame
 from seadesign.errors import DataError
 
@@ -161,4 +163,35 @@ def quaternion_to_euler(q: np.ndarray) -> np.ndarray:
     return np.stack([roll, pitch, yaw], axis=1)
 
 
-__all__ = ["CleanResult", "clean", "quaternion_to_euler"]
+
+
+def write_cleaned(result: CleanResult, path: str | Path, source: str = "") -> Path:
+    """Write the cleaned table as a flat CSV (one column per value, names as in the table) and a
+    sidecar holding the step log, the removed rows per reason and the column units."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    result.table.to_csv(path, index=False)
+    normalised = any(s["step"] == "normalise" for s in result.log)
+    pos_unit = "rad/pi" if normalised else "rad"
+    units = {c: _unit(c, pos_unit) for c in result.table.columns}
+    write_metadata(path, {"format": "seadesign cleaned recording", "source": source, "steps": result.log,
+                          "removed_rows": result.removed, "rows": len(result.table), "column_units": units})
+    return path
+
+
+def _unit(column: str, pos_unit: str) -> str:
+    if column.endswith(("_knee_pos", "_hall_pos", "_cmd_pos")):
+        return pos_unit
+    if column.endswith(("_vel", "gyro_x", "gyro_y", "gyro_z")):
+        return "rad/s"
+    if column.startswith("imu_acc"):
+        return "m/s^2"
+    if column.endswith("_acc"):
+        return "rad/s^2"
+    if column.endswith("_eff"):
+        return "Nm"
+    if column in ("time_s", "timestamp"):
+        return "s"
+    if column.endswith("_rad"):
+        return "rad"
+    return "1"

@@ -2,8 +2,8 @@
 
 A parametric stand-in for the robot's walk engine, shaped after the real recordings
 (`free_dtest_part1.csv`: standing at about 1.0 rad, walking around 1.2 rad with swing peaks
-near 1.75 rad, about 0.8 s per step cycle): each trial stands, blends into walking, and then
-walks with a fixed direction and speed. The left knee swings in the first half of the cycle,
+near 1.75 rad, about 0.8 s per step cycle): each trial stands, blends into walking, walks
+with a fixed direction and speed, and blends back into standing at its end. The left knee swings in the first half of the cycle,
 the right one half a cycle later. All angles here are knee flexion (positive, the left knee's
 sign); the recording mirrors the right knee.
 
@@ -62,6 +62,7 @@ class Gait:
     walk_base_rad: float = 1.2
     lift_rad: float = 0.55
     stand_s: float = 1.0
+    stop_s: float = 0.5  # standing at the end of a trial, so trials join without a jump
     blend_s: float = 0.6
     cycle_s: float = 0.8
     swing_fraction: float = 0.42  # share of the cycle a foot is in the air
@@ -95,7 +96,8 @@ def knee_targets(trials: list[Trial], rate_hz: float, gait: Gait = Gait()) -> tu
     swinging = phase < gait.swing_fraction
     swing_s = np.where(swinging, phase / gait.swing_fraction, 0.0)
     stance_s = np.where(swinging, 0.0, (phase - gait.swing_fraction) / (1.0 - gait.swing_fraction))
-    walking = _smoothstep(walk_t / gait.blend_s)[None, :, None]
+    stop_t = time[-1] + 1.0 / rate_hz - gait.stop_s - time  # time left before the final stand
+    walking = (_smoothstep(walk_t / gait.blend_s) * _smoothstep(stop_t / gait.blend_s))[None, :, None]
     gait_shape = (gait.walk_base_rad - gait.stand_rad
                   + lift * np.sin(np.pi * swing_s) ** 2
                   + gait.stance_flex_per_speed * v_eff * np.sin(np.pi * stance_s))
