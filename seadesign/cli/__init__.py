@@ -33,4 +33,5 @@ def main() -> None:
 
 # Subcommand modules register themselves on `main` when imported.
 from seadesign.cli import design_cmds  # noqa: E402,F401
+from seadesign.cli import corrector_cmds  # noqa: E402,F401
 from seadesign.cli import data_cmds  # noqa: E402,F401

@@ -39,9 +39,12 @@ class Recording:
     time_s: np.ndarray
     knees: dict[str, dict[str, np.ndarray]]
     setting: str = "unknown"  # "hanging", "ground" or "sim"
+    segment: np.ndarray | None = None  # contiguous-piece id per sample; samples never pair across pieces
 
     def __post_init__(self) -> None:
         n = len(self.time_s)
+        if self.segment is not None and len(self.segment) != n:
+            raise DataError(f"recording {self.name}: segment has {len(self.segment)} entries, time_s has {n}")
         for knee in KNEES:
             if knee not in self.knees:
                 raise DataError(f"recording {self.name}: knee '{knee}' is missing; give both 'left' and 'right'")
@@ -125,6 +128,8 @@ def _knee_rows(rec: Recording, knee: str, spec: DatasetSpec) -> tuple[np.ndarray
     ch = rec.knees[knee]
     n = len(rec.time_s)
     t = np.arange(spec.history, n - 1)
+    if rec.segment is not None:  # the window t-history .. t+1 must lie in one contiguous piece
+        t = t[rec.segment[t - spec.history] == rec.segment[t + 1]]
     if len(t) == 0:
         raise DataError(
             f"recording {rec.name} has {n} samples, too few for history {spec.history} plus one step ahead"

@@ -19,7 +19,13 @@ ALL = channels(tuple(MODALITIES))
 
 
 def run_open_loop(corrector: Corrector, rec: Recording, task: str) -> dict[str, np.ndarray]:
-    """Commands for every step t < T-1 of `rec` (robot frame, rad), per knee; index = step t."""
+    """Commands for every step t < T-1 of `rec` (robot frame, rad), per knee; index = step t.
+
+    The target follows `task` ("thesis": Hall position at t; "inverse": at t+1); a trained
+    corrector uses the task it was trained for.
+    """
+    spec = getattr(corrector, "spec", None)
+    task = spec.task if spec is not None else task
     corrector.reset()
     dt = np.diff(rec.time_s, prepend=rec.time_s[0])
     out = {}
@@ -37,11 +43,11 @@ def run_open_loop(corrector: Corrector, rec: Recording, task: str) -> dict[str, 
 
 
 def metrics(err: np.ndarray, truth: np.ndarray) -> dict[str, float]:
-    """MSE (rad^2), MAE (rad), MAPE (%), peak |error| (rad), MSE / pi^2 (thesis units)."""
+    """MSE (rad^2), MAE (rad), MAPE (%), peak |error| (rad), MSE of positions / pi (thesis units, (rad/pi)^2)."""
     mse = float(np.mean(err ** 2))
-    return {"n": int(len(err)), "mse_rad2": mse, "mae_rad": float(np.mean(np.abs(err))),
+    return {"n_samples": int(len(err)), "mse_rad2": mse, "mae_rad": float(np.mean(np.abs(err))),
             "mape_pct": float(100 * np.mean(np.abs(err) / np.maximum(np.abs(truth), 1e-6))),
-            "peak_rad": float(np.max(np.abs(err))), "mse_thesis_norm": mse / np.pi ** 2}
+            "peak_rad": float(np.max(np.abs(err))), "mse_norm_pi2": mse / np.pi ** 2}
 
 
 def open_loop_table(correctors: list[Corrector], recordings: list[Recording], ds: CorrectorDataset,

@@ -1,0 +1,94 @@
+"""`seadesign train` and `seadesign evaluate`: the corrector's command line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from seadesign.cli import main
+from seadesign.corrector.dataset import TASKS, DatasetSpec
+from seadesign.corrector.models import MODEL_KINDS
+from seadesign.corrector.recordings import load_recordings
+from seadesign.corrector.splits import SPLITS
+from seadesign.corrector.train import TrainConfig
+from seadesign.corrector.workflow import DEFAULT_HISTORY, candidate_name, evaluate_bundles, train_bundle
+from seadesign.handoff import load_spring
+
+
+def _models(text: str) -> list[str]:
+    models = [m.strip() for m in text.split(",") if m.strip()]
+    bad = [m for m in models if m not in MODEL_KINDS]
+    if bad or not models:
+        raise click.BadParameter(f"unknown model(s) {bad}; choose from {', '.join(MODEL_KINDS)} (comma-separated)")
+    return models
+
+
+@main.command()
+@click.option("--spring", "spring_path", required=True, type=click.Path(dir_okay=False),
+              help="spring.json from `seadesign sweep` (k is read from it; the file must pass its schema)")
+@click.option("--data", "data", required=True, multiple=True, type=click.Path(exists=True, dir_okay=False),
+              help="robot recording CSV (repeat for several files)")
+@click.option("--model", "model_text", default="mlp", show_default=True,
+              help=f"one or more of {', '.join(MODEL_KINDS)}, comma-separated")
+@click.option("--modalities", default="velocity_effort", show_default=True,
+              help="a thesis combination name (target_only, velocity_effort, all, ...) or a comma-separated "
+                   "list of motor_pos, hall_pos, motor_vel, hall_vel, effort, imu, pressure")
+@click.option("--task", type=click.Choice(TASKS), default="thesis", show_default=True,
+              help="thesis: target = Hall position at t; inverse: target = Hall position at t+1")
+@click.option("--positive/--normal", default=True, show_default=True,
+              help="mirror the right knee so both knees look alike (thesis 'positive' dataset)")
+@click.option("--history", type=int, default=None,
+              help=f"past samples as extra inputs (default 0; {DEFAULT_HISTORY} for the history model)")
+@click.option("--split", "split_name", type=click.Choice(SPLITS), default="time_blocks", show_default=True)
+@click.option("--test-recording", multiple=True, help="recording name(s) held out by --split by_recording")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--max-epochs", type=int, default=TrainConfig.max_epochs, show_default=True)
+@click.option("--patience", type=int, default=TrainConfig.patience, show_default=True, help="epochs")
+@click.option("--max-seconds", type=float, default=TrainConfig.max_seconds, show_default=True, help="s per model")
+@click.option("--batch-size", type=int, default=TrainConfig.batch_size, show_default=True)
+@click.option("--lr", type=float, default=TrainConfig.lr, show_default=True, help="Adam learning rate")
+@click.option("-o", "--out", "out", type=click.Path(file_okay=False), default=None,
+              help="bundle folder (several models: one subfolder each); default exports/<study>/corrector/")
+def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: str, task: str, positive: bool,
+          history: int | None, split_name: str, test_recording: tuple[str, ...], seed: int, max_epochs: int,
+          patience: int, max_seconds: float, batch_size: int, lr: float, out: str | None) -> None:
+    """Train corrector network(s) on recordings and export TorchScript + NumPy bundles."""
+    models = _models(model_text)
+    spring = load_spring(spring_path)
+    recs = load_recordings(list(data))
+    cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=max_seconds,
+                      batch_size=batch_size, lr=lr)
+    root = Path(out) if out else Path("exports") / spring["study"] / "corrector"
+    for model in models:
+        h = history if history is not None else (DEFAULT_HISTORY if model == "history" else 0)
+        spec = DatasetSpec(task, modalities, h, positive)
+        name = candidate_name(model, spec)
+        target = root if (out and len(models) == 1) else root / name
+        path, res = train_bundle(spring_path, list(data), model, spec, split_name, cfg, target,
+                                 list(test_recording) or None, recordings=recs)
+        s = res.summary()
+        click.echo(f"{name}: best validation MSE {s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} "
+                   f"({s['stopped']}, {s['wall_s']:.1f} s, {s['samples_per_s']:.0f} samples/s) -> {path}")
+
+
+@main.command()
+@click.argument("bundles", nargs=-1, required=True, type=click.Path(exists=True, file_okay=False))
+@click.option("--data", "data", required=True, multiple=True, type=click.Path(exists=True, dir_okay=False),
+              help="recording CSV(s) to evaluate on; training files contribute only their held-out rows")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None, help="also write results as JSON")
+@click.option("-o", "--out", "out", type=click.Path(file_okay=False), default=None,
+              help="output folder; default exports/<study>/corrector/evaluation")
+@click.option("--kp", type=float, default=0.2, show_default=True, help="PI baseline proportional gain")
+@click.option("--ki", type=float, default=0.1, show_default=True, help="PI baseline integral gain, 1/s")
+def evaluate(bundles: tuple[str, ...], data: tuple[str, ...], json_path: str | None, out: str | None,
+             kp: float, ki: float) -> None:
+    """Score corrector bundles against the baselines; write tables (CSV, Markdown[, JSON]) and plots."""
+    res = evaluate_bundles(list(bundles), list(data), out, json_path, kp, ki)
+    both = [r for r in res["open_loop"] if r["knee"] == "both"]
+    click.echo(f"open loop ({res['settings']['rows']}):")
+    for r in both:
+        click.echo(f"  {r['candidate']:<45} MAE {r['mae_rad']:.4f} rad  MSE {r['mse_rad2']:.4g} rad^2  "
+                   f"peak {r['peak_rad']:.3f} rad")
+    for f in res["files"]:
+        click.echo(f"wrote {f}")

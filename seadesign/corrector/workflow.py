@@ -1,0 +1,156 @@
+"""Train-and-export and evaluate-bundles workflows behind the CLI (`seadesign train`, `seadesign evaluate`).
+
+A trained corrector is a bundle directory (see `export.py`); its meta.json records the spring
+(k and where it came from), the data files (SHA-256), the dataset spec, split, training settings
+and outcome, and versions, so every number can be traced back.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from seadesign.corrector.dataset import CorrectorDataset, DatasetSpec, Recording, build_dataset
+from seadesign.corrector.evaluate import open_loop_table
+from seadesign.corrector.export import export_bundle, input_list, load_meta, load_numpy, versions
+from seadesign.corrector.modalities import COMBINATIONS
+from seadesign.corrector.recordings import load_recordings
+from seadesign.corrector.report import plot_curves, plot_predictions, write_table
+from seadesign.corrector.runtime import Corrector, FeedForward, HallPI, NetCorrector, NoCorrection
+from seadesign.corrector.splits import Split, make_split
+from seadesign.corrector.train import TrainConfig, TrainResult, fit
+from seadesign.errors import SeadesignError
+from seadesign.handoff import load_spring
+
+DEFAULT_HISTORY = 3  # samples, for the history model when no --history is given
+
+
+def candidate_name(model: str, spec: DatasetSpec) -> str:
+    """Readable name: model, normal/positive, modalities (combination name when one matches), history."""
+    mods = next((k for k, v in COMBINATIONS.items() if v == spec.modalities), "+".join(spec.modalities))
+    hist = f"-h{spec.history}" if spec.history else ""
+    return f"{model}-{'positive' if spec.positive else 'normal'}-{mods}{hist}-{spec.task}"
+
+
+def file_digest(path: str | Path) -> str:
+    """SHA-256 of a file's bytes."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def data_record(paths: list[str | Path]) -> list[dict[str, str]]:
+    """Name, absolute path and SHA-256 of each data file."""
+    return [{"name": Path(p).stem, "path": str(Path(p).resolve()), "sha256": file_digest(p)} for p in paths]
+
+
+def train_bundle(spring_path: str | Path, data_paths: list[str | Path], model: str, spec: DatasetSpec,
+                 split_name: str, config: TrainConfig, out_dir: str | Path,
+                 test_recordings: list[str] | None = None,
+                 recordings: list[Recording] | None = None) -> tuple[Path, TrainResult]:
+    """Train one corrector on recording files and export it as a bundle into `out_dir`.
+
+    The spring file is validated first (SpringFileError when it fails its schema); k comes from it.
+    `recordings` may be given already loaded (same order as `data_paths`).
+    """
+    spring = load_spring(spring_path)
+    k = float(spring["k_Nm_per_rad"])
+    recs = recordings if recordings is not None else load_recordings(data_paths)
+    ds = build_dataset(recs, spec)
+    split = make_split(ds, split_name, seed=config.seed, test_recordings=test_recordings)
+    result = fit(ds, split, k, TrainConfig(**{**config.__dict__, "model": model}))
+    meta = {
+        "name": candidate_name(model, spec), "model": model, "dataset": spec.to_dict(),
+        "inputs": input_list(ds.feature_names, model == "siamese"),
+        "output": "motor position command at t+1, rad (robot frame after un-mirroring)",
+        "positive_note": "right-knee inputs and output are sign-flipped" if spec.positive else "",
+        "k_Nm_per_rad": k,
+        "spring": {"path": str(Path(spring_path).resolve()), "study": spring["study"], "k_source": spring["k_source"],
+                   "inputs_hash": spring["inputs_hash"]},
+        "data": data_record(data_paths), "n_samples": len(ds), "split": split.describe(),
+        "training": result.summary(),
+    }
+    out = export_bundle(result.net, meta, out_dir)
+    pd.DataFrame(result.curve).to_csv(out / "training_curve.csv", index=False)
+    return out, result
+
+
+def find_bundles(paths: list[str | Path]) -> list[Path]:
+    """Bundle directories among `paths` (a bundle itself, or a folder holding bundles)."""
+    found: list[Path] = []
+    for p in map(Path, paths):
+        if (p / "meta.json").exists():
+            found.append(p)
+        elif p.is_dir():
+            found.extend(sorted(d for d in p.iterdir() if (d / "meta.json").exists()))
+    if not found:
+        raise SeadesignError(f"no corrector bundle (folder with meta.json) in {', '.join(map(str, paths))}; "
+                             "create one with `seadesign train`")
+    return found
+
+
+def load_corrector(bundle: str | Path) -> tuple[NetCorrector, dict[str, Any]]:
+    """A bundle as an online corrector (NumPy path) plus its meta."""
+    meta = load_meta(bundle)
+    d = meta["dataset"]
+    spec = DatasetSpec(d["task"], tuple(d["modalities"]), d["history"], d["positive"])
+    return NetCorrector(load_numpy(bundle), spec, meta["name"]), meta
+
+
+def evaluation_rows(meta: dict, data_paths: list[str | Path], recs: list[Recording]) -> tuple[CorrectorDataset, Split, str]:
+    """The dataset of the reference bundle on `data_paths` and the rows to score.
+
+    Files the bundle was trained on contribute only the held-out rows of its own split (rebuilt
+    with the same settings); files it never saw contribute every row.
+    """
+    d = meta["dataset"]
+    spec = DatasetSpec(d["task"], tuple(d["modalities"]), d["history"], d["positive"])
+    ds = build_dataset(recs, spec)
+    trained = {r["sha256"] for r in meta["data"]}
+    seen = np.array([file_digest(p) in trained for p in data_paths])
+    unseen_rows = np.flatnonzero(~seen[ds.recording])
+    if seen.all() and len(seen) == len(trained):
+        sp = meta["split"]
+        split = make_split(ds, sp["split"], seed=sp["seed"], test_recordings=sp.get("test_recordings"))
+        return ds, split, f"{split.name} held-out rows of the training files"
+    if not seen.any():
+        return ds, Split("unseen_recordings", np.array([], int), np.array([], int), np.arange(len(ds))), \
+            "recordings not used in training (all rows)"
+    return ds, Split("unseen_recordings", np.array([], int), np.array([], int), unseen_rows), \
+        "rows of the recordings not used in training"
+
+
+def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path], out_dir: str | Path | None = None,
+                     json_path: str | Path | None = None, kp: float = 0.2, ki: float = 0.1) -> dict[str, Any]:
+    """Open-loop table of all bundles vs the baselines (none, PI, feed-forward), plots and settings.
+
+    Rows scored: see `evaluation_rows` (decided by the first bundle). Default output folder:
+    exports/<study>/corrector/evaluation.
+    """
+    bundles = find_bundles(bundle_paths)
+    nets = [load_corrector(b) for b in bundles]
+    ref_meta = nets[0][1]
+    k = float(ref_meta["k_Nm_per_rad"])
+    out = Path(out_dir) if out_dir else Path("exports") / ref_meta["spring"]["study"] / "corrector" / "evaluation"
+    recs = load_recordings(data_paths)
+    ds, split, rows_note = evaluation_rows(ref_meta, data_paths, recs)
+    correctors: list[Corrector] = [NoCorrection(), HallPI(kp, ki), FeedForward(k)] + [c for c, _ in nets]
+    table, traces = open_loop_table(correctors, recs, ds, split.test, split.name)
+    context = {"rows": rows_note, "reference_bundle": str(bundles[0]), "data": data_record(data_paths),
+               "k_Nm_per_rad": k, "pi": {"kp": kp, "ki": ki}, "versions": versions(),
+               "candidates": {m["name"]: {"bundle": str(b), "training": m["training"], "split": m["split"]}
+                              for b, (_, m) in zip(bundles, nets)}}
+    files = write_table(table, out, "open_loop", context)
+    plots = [plot_predictions(traces, out / "predictions_left.png", knee=0),
+             plot_predictions(traces, out / "predictions_right.png", knee=1),
+             plot_curves({m["name"]: pd.read_csv(b / "training_curve.csv").to_dict("records")
+                          for b, (_, m) in zip(bundles, nets)}, out / "training_curves.png")]
+    result = {"open_loop": table.to_dict("records"), "settings": context,
+              "files": [str(p) for p in [*files.values(), *plots]]}
+    if json_path:
+        Path(json_path).parent.mkdir(parents=True, exist_ok=True)
+        Path(json_path).write_text(json.dumps(result, indent=2, default=str) + "\n")
+    return result
