@@ -1,11 +1,16 @@
 """Robot recording files -> corrector `Recording`s, through the data module's reader and cleaning.
 
-Column mapping of the data module's table (per knee side l / r): `<s>_knee_pos` -> motor_pos_rad,
-`<s>_hall_pos` -> hall_pos_rad, `<s>_knee_vel` -> motor_vel_rad_per_s, `<s>_hall_vel` ->
-hall_vel_rad_per_s, `<s>_knee_eff` -> effort_Nm; IMU orientation as roll/pitch/yaw (rad) from the
-quaternion; the knee's own foot pressure cells first, then the other foot's. Rows removed by the
-cleaning (gaps in the row index) and time gaps longer than `GAP_FACTOR` x the median step split a
-recording into segments that no sample pairs across.
+Each file is read (`seadesign.data.read_recording`) and cleaned (`seadesign.data.clean`: lifted
+rows dropped on ground recordings, artefacts dropped, wraps undone, Hall offsets removed, IMU
+quaternion -> Euler). A file whose foot pressures are all below the threshold is a hanging
+recording and is cleaned with `keep_lifted`. Positions stay in rad and the knees unmirrored
+here: the corrector dataset does its own mirroring ("positive") so that it can un-mirror online.
+
+Column mapping (per knee side l / r): `<s>_knee_pos` -> motor_pos_rad, `<s>_hall_pos` ->
+hall_pos_rad, `<s>_knee_vel` -> motor_vel_rad_per_s, `<s>_hall_vel` -> hall_vel_rad_per_s,
+`<s>_knee_eff` -> effort_Nm; the knee's own foot pressure cells first, then the other foot's.
+Rows removed by the cleaning and time gaps above `GAP_FACTOR` x the median step split a recording
+into segments that no sample pairs across.
 """
 
 from __future__ import annotations
@@ -17,39 +22,38 @@ import pandas as pd
 
 from seadesign.corrector.dataset import Recording
 from seadesign.corrector.modalities import IMU_CHANNELS, PRESSURE_CHANNELS
-from seadesign.data import read_recording
+from seadesign.data import clean, read_recording
 from seadesign.errors import DataError
 
 GAP_FACTOR = 10.0
+PRESSURE_THRESHOLD = 10.0  # summed foot pressure (8 cells, the robot's cell units) below which a row is "lifted"
 _SIDES = {"left": "l", "right": "r"}
 _KNEE_MAP = {"knee_pos": "motor_pos_rad", "hall_pos": "hall_pos_rad", "knee_vel": "motor_vel_rad_per_s",
              "hall_vel": "hall_vel_rad_per_s", "knee_eff": "effort_Nm"}
+_IMU_COLUMNS = ["imu_roll_rad", "imu_pitch_rad", "imu_yaw_rad", "imu_gyro_x", "imu_gyro_y", "imu_gyro_z",
+                "imu_acc_x", "imu_acc_y", "imu_acc_z"]
 
 
-def quaternion_to_euler(qx: np.ndarray, qy: np.ndarray, qz: np.ndarray, qw: np.ndarray) -> np.ndarray:
-    """(n, 3) roll, pitch, yaw (rad; ZYX convention) from unit quaternions (x, y, z, w)."""
-    roll = np.arctan2(2 * (qw * qx + qy * qz), 1 - 2 * (qx * qx + qy * qy))
-    pitch = np.arcsin(np.clip(2 * (qw * qy - qz * qx), -1.0, 1.0))
-    yaw = np.arctan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
-    return np.column_stack([roll, pitch, yaw])
-
-
-def segments(index: np.ndarray, time_s: np.ndarray) -> np.ndarray:
-    """Segment id per row: a new segment after a dropped row or a time gap > GAP_FACTOR x median step."""
+def segments(source_row: np.ndarray, time_s: np.ndarray) -> np.ndarray:
+    """Segment id per row: a new segment after a removed row or a time gap > GAP_FACTOR x median step."""
     dt = np.diff(time_s)
     med = float(np.median(dt)) if len(dt) else 0.0
-    breaks = (np.diff(index) != 1) | (dt > GAP_FACTOR * med)
+    breaks = (np.diff(source_row) != 1) | (dt > GAP_FACTOR * med)
     return np.concatenate([[0], np.cumsum(breaks)])
 
 
 def recording_from_frame(df: pd.DataFrame, name: str, setting: str = "recorded") -> Recording:
-    """Convert a data-module recording table (read_recording / clean output) into a Recording."""
+    """Convert a cleaned table (`clean(...).table`, positions in rad, not mirrored) into a Recording.
+
+    Uses column `source_row` (row number in the file) when present to find removed rows.
+    """
     if len(df) < 3:
         raise DataError(f"recording {name} has {len(df)} rows after cleaning; at least 3 are needed")
+    missing = [c for c in _IMU_COLUMNS if c not in df.columns]
+    if missing:
+        raise DataError(f"recording {name}: columns {missing} missing; clean it with the Euler step on")
     time_s = df["time_s"].to_numpy(dtype=float)
-    euler = quaternion_to_euler(*(df[c].to_numpy(dtype=float) for c in ("imu_qx", "imu_qy", "imu_qz", "imu_qw")))
-    imu_rest = df[["imu_gyro_x", "imu_gyro_y", "imu_gyro_z", "imu_acc_x", "imu_acc_y", "imu_acc_z"]].to_numpy(float)
-    imu = np.column_stack([euler, imu_rest])
+    imu = df[_IMU_COLUMNS].to_numpy(dtype=float)
     knees = {}
     for knee, s in _SIDES.items():
         other = "r" if s == "l" else "l"
@@ -59,15 +63,22 @@ def recording_from_frame(df: pd.DataFrame, name: str, setting: str = "recorded")
                                  df[[f"{other}_pressure_{i}" for i in range(4)]].to_numpy(float)])
         ch.update(zip(PRESSURE_CHANNELS, cells.T))
         knees[knee] = ch
-    index = np.asarray(df.index, dtype=np.int64) if pd.api.types.is_integer_dtype(df.index) else np.arange(len(df))
-    return Recording(name, time_s, knees, setting, segments(index, time_s))
+    rows = df["source_row"].to_numpy(dtype=np.int64) if "source_row" in df.columns else np.arange(len(df))
+    return Recording(name, time_s, knees, setting, segments(rows, time_s))
+
+
+def load_recording(path: str | Path) -> tuple[Recording, list[dict]]:
+    """Read and clean one recording file; returns the Recording and the cleaning log."""
+    df = read_recording(path)
+    df["source_row"] = np.arange(len(df))
+    cells = [c for c in df.columns if "_pressure_" in c]
+    hanging = bool((df[cells].to_numpy(dtype=float).sum(axis=1) < PRESSURE_THRESHOLD).all())
+    res = clean(df, pressure_threshold=PRESSURE_THRESHOLD, keep_lifted=hanging, normalise=False, positive=False)
+    meta = df.attrs.get("metadata") or {}
+    setting = str(meta.get("setting", "hanging" if hanging else "ground"))
+    return recording_from_frame(res.table, Path(path).stem, setting), res.log
 
 
 def load_recordings(paths: list[str | Path]) -> list[Recording]:
-    """Read and clean recording files with the data module, then convert them."""
-    out = []
-    for p in paths:
-        df = read_recording(p)
-        meta = df.attrs.get("metadata") or {}
-        out.append(recording_from_frame(df, Path(p).stem, str(meta.get("setting", "recorded"))))
-    return out
+    """Read and clean several recording files (order kept)."""
+    return [load_recording(p)[0] for p in paths]
