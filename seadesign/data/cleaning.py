@@ -133,7 +133,7 @@ def _remove_offset(res: CleanResult, keep: np.ndarray, report, side: str, pressu
     hall = s * t[f"{side}_hall_pos"].to_numpy(dtype=float)
     masks = report.masks[side]
     unloaded = np.ones_like(pressure, dtype=bool) if keep_lifted else pressure < threshold
-    big = np.flatnonzero(masks["step"] | masks["wrap"] | masks["jump"])
+    big = np.flatnonzero(masks["step"] | masks["jump"])  # unwrapped wraps keep the offset
     bounds = [0, *big.tolist(), len(t)]
     offsets, unknown = [], np.zeros(len(t), dtype=bool)
     for a, b in zip(bounds[:-1], bounds[1:]):

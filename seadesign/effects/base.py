@@ -131,15 +131,17 @@ class Effect:
             name = self.signal(role)
             if name in signals:
                 out[role] = np.asarray(signals[name], dtype=float)
-            elif role == self.writes:
-                out[role] = None  # filled below with zeros
+            elif role == self.writes and role not in self.reads:
+                out[role] = None  # an additive target starts at zero
             else:
                 raise ConfigError(
                     f"effect '{self.name}' needs signal '{name}' (role {role}, {SIGNALS.get(role, ('?', ''))[0]}); "
                     f"available: {', '.join(signals)}"
                 )
         if out.get(self.writes) is None:
-            ref = next(v for v in out.values() if v is not None) if like is None else like
+            ref = next((v for v in out.values() if v is not None), None) if like is None else like
+            if ref is None:
+                raise ConfigError(f"effect '{self.name}' needs signal '{self.target()}'; available: {', '.join(signals)}")
             out[self.writes] = np.zeros_like(ref, dtype=float)
         return out
 
