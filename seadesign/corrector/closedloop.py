@@ -43,7 +43,7 @@ _ABSENT = dict.fromkeys(IMU_CHANNELS + PRESSURE_CHANNELS, float("nan"))
 
 @dataclass
 class ClosedLoopRun:
-    """Logged arrays (n_trials, n_steps, 2) in the robot frame: target, hall, command; plus flags."""
+    """Logged arrays (n_trials, n_steps, 2) in the robot frame: target, hall, command (rad), effort (Nm); flags."""
 
     name: str
     rate_hz: float
@@ -51,6 +51,7 @@ class ClosedLoopRun:
     target: np.ndarray
     hall: np.ndarray
     command: np.ndarray
+    effort: np.ndarray
     unstable: bool
     oscillating: bool
     note: str = ""
@@ -75,7 +76,7 @@ def run_closed_loop(corrector: Corrector, spring: dict[str, Any], trials: list[T
         c.reset()
         copies.append(c)
     shape = (sim.n_trials, sim.n_steps, 2)
-    target, hall, command = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
+    target, hall, command, effort = (np.full(shape, np.nan) for _ in range(4))
     obs, unstable, note = sim.observe(), False, ""
     while obs is not None:
         cmd = np.empty((sim.n_trials, 2))
@@ -84,6 +85,7 @@ def run_closed_loop(corrector: Corrector, spring: dict[str, Any], trials: list[T
                 measured = {dst: float(getattr(obs, src)[i, k]) for src, dst in _FIELDS.items()}
                 cmd[i, k] = c.command(knee, float(obs.target[i, k]), {**measured, **_ABSENT}, sim.dt)
         target[:, obs.step], hall[:, obs.step], command[:, obs.step] = obs.target, obs.hall_pos, cmd
+        effort[:, obs.step] = obs.knee_eff
         if not np.isfinite(cmd).all() or np.abs(cmd - obs.target).max() > UNSTABLE_COMMAND_RAD \
                 or np.abs(obs.hall_pos).max() > UNSTABLE_HALL_RAD:
             unstable = True
@@ -95,7 +97,7 @@ def run_closed_loop(corrector: Corrector, spring: dict[str, Any], trials: list[T
             unstable, note = True, f"simulator refused the command at step {obs.step}: {exc}"
             break
     chatter = chatter_rms(command, target, rate_hz)
-    return ClosedLoopRun(corrector.name, rate_hz, trials, target, hall, command, unstable,
+    return ClosedLoopRun(corrector.name, rate_hz, trials, target, hall, command, effort, unstable,
                          bool(np.nanmax(chatter) > CHATTER_RMS_RAD), note)
 
 

@@ -7,7 +7,10 @@ frame, SI). `reset()` clears internal state between trials.
 - `NoCorrection`: command = target.
 - `HallPI`: the thesis's PI on the Hall error e = target - hall (kp 0.2, ki 0.1 by default).
 - `FeedForward`: command = target + effort / k (adds the deflection a linear spring of
-  stiffness k shows under the measured torque).
+  stiffness k shows under the measured torque). The effort is low-pass filtered (time constant
+  `filter_s`): fed back unfiltered it also carries the link's inertial torque, and the loop
+  through the servo then acts as an undamped integral controller on the Hall error that
+  oscillates (seen in the knee simulator). At rest the filter changes nothing.
 - `NetCorrector`: a trained network (NumPy path of an exported bundle).
 """
 
@@ -62,18 +65,26 @@ class HallPI:
 
 
 class FeedForward:
-    """Physics feed-forward: command = target + effort / k (k in Nm/rad from spring.json)."""
+    """Physics feed-forward: command = target + lowpass(effort) / k (k in Nm/rad from spring.json,
+    filter time constant `filter_s` in s; 0 = unfiltered)."""
 
-    def __init__(self, k_Nm_per_rad: float, name: str = "feedforward") -> None:
+    def __init__(self, k_Nm_per_rad: float, filter_s: float = 0.1, name: str = "feedforward") -> None:
         if k_Nm_per_rad <= 0:
             raise SeadesignError(f"k_Nm_per_rad must be > 0, got {k_Nm_per_rad}")
-        self.k, self.name = k_Nm_per_rad, name
+        if filter_s < 0:
+            raise SeadesignError(f"feed-forward filter time constant must be >= 0 s, got {filter_s}")
+        self.k, self.filter_s, self.name = k_Nm_per_rad, filter_s, name
+        self.reset()
 
     def reset(self) -> None:
-        """Stateless."""
+        self._effort: dict[str, float | None] = {k: None for k in KNEES}
 
     def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float) -> float:
-        return target_rad + measured["effort_Nm"] / self.k
+        tau, prev = measured["effort_Nm"], self._effort[knee]
+        if prev is not None and self.filter_s > 0:
+            tau = prev + (tau - prev) * min(1.0, dt_s / self.filter_s)
+        self._effort[knee] = tau
+        return target_rad + tau / self.k
 
 
 class NetCorrector:

@@ -1,0 +1,57 @@
+"""Closed loop in the knee simulator: feed-forward cancels a linear spring, instability is caught."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from seadesign.corrector.closedloop import closed_loop_table, run_closed_loop
+from seadesign.corrector.runtime import FeedForward, HallPI, NoCorrection
+from seadesign.twin import Gait, KneeConfig, Trial, knee_effects
+
+STATIC = Gait(stand_rad=1.0, walk_base_rad=1.0, lift_rad=0.0, stance_flex_per_speed=0.0)
+
+
+def _spring_only(spring: dict):
+    """Linear spring, gravity and viscous link damping; no backlash, friction steps or sensor effects."""
+    chain = knee_effects(KneeConfig.from_spring(spring))
+    for name in ("backlash", "gear_friction", "hall_noise", "hall_quantisation", "motor_quantisation", "effort_noise"):
+        chain = chain.configure(name, enabled=False)
+    return chain.configure("friction", coulomb_Nm=0.0, viscous_Nm_s_per_rad=0.3)
+
+
+def test_feedforward_cancels_linear_spring_deflection(spring_dict):
+    """At rest the servo's P law gives qm = command - tau / Kp and the spring hall = qm - tau / k.
+    Without correction the Hall error is -(tau/k + tau/Kp); with command = target + tau/k it must be
+    exactly -tau/Kp: the spring's whole deflection is cancelled, only the servo's own error is left."""
+    kp = KneeConfig.from_spring(spring_dict).p_gain_Nm_per_rad
+    k = spring_dict["k_Nm_per_rad"]
+    trial = [Trial("front", 0.0, 3.0)]
+    none = run_closed_loop(NoCorrection(), spring_dict, trial, effects=_spring_only(spring_dict), gait=STATIC)
+    ff = run_closed_loop(FeedForward(k), spring_dict, trial, effects=_spring_only(spring_dict), gait=STATIC)
+    for run, expected in ((none, lambda tau: -(tau / k + tau / kp)), (ff, lambda tau: -tau / kp)):
+        assert not run.unstable and not run.oscillating
+        flex = run.hall[0, -1] * [1, -1] - run.target[0, -1] * [1, -1]  # knee flexion convention
+        tau = run.effort[0, -1] * [1, -1]
+        np.testing.assert_allclose(flex, expected(tau), atol=1e-6)
+    assert abs(ff.hall[0, -1, 0] - ff.target[0, -1, 0]) < 0.2 * abs(none.hall[0, -1, 0] - none.target[0, -1, 0])
+
+
+def test_closed_loop_flags_unstable_and_oscillating_controllers(spring_dict):
+    trials = [Trial("front", 0.1, 2.5), Trial("back_right", 0.2, 2.5)]
+    table, runs = closed_loop_table(
+        [NoCorrection(), HallPI(), HallPI(kp=-1.5, ki=0.0, name="positive_feedback"),
+         HallPI(kp=3.0, ki=5.0, name="high_gain")], spring_dict, ("hanging",), trials)
+    flags = table.set_index("candidate")
+    assert not flags.loc["none", "unstable_flag"] and not flags.loc["none", "oscillating_flag"]
+    assert not flags.loc["pi", "unstable_flag"] and not flags.loc["pi", "oscillating_flag"]
+    assert flags.loc["positive_feedback", "unstable_flag"]
+    assert flags.loc["high_gain", "unstable_flag"] or flags.loc["high_gain", "oscillating_flag"]
+    assert {"mean_abs_error_rad", "worst_trial", "best_trial", "peak_abs_error_rad"} <= set(table.columns)
+
+
+def test_closed_loop_refuses_unknown_setting(spring_dict):
+    from seadesign.errors import SeadesignError
+
+    with pytest.raises(SeadesignError, match="hanging or ground"):
+        closed_loop_table([NoCorrection()], spring_dict, ("upside_down",), [Trial("front", 0.1, 1.0)])
