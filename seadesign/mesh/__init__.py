@@ -1,0 +1,159 @@
+"""Tetrahedral meshes of the compliant element with named boundary facets.
+
+Entry point: mesh_part(). Inputs in mm (part coordinates: axis +z, z in [0, thickness]).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from seadesign.errors import MeshError
+from seadesign.mesh import cache
+from seadesign.mesh.surface import load_stl, tessellate_solid
+from seadesign.mesh.tetmesh import MeshQuality, TetMesh, build_tetmesh
+from seadesign.part import Interfaces
+
+__all__ = ["BACKENDS", "MeshQuality", "TetMesh", "load_stl", "mesh_part"]
+
+BACKENDS = ("gmsh", "pytetwild")
+REGULAR_TET_VOLUME = 1.0 / (6.0 * np.sqrt(2.0))  # volume of a regular tetrahedron of unit edge
+
+
+def _surface_volume(v: np.ndarray, f: np.ndarray) -> float:
+    t = v[f]
+    return float(abs(np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])).sum()) / 6.0)
+
+
+def _run_worker(job: dict, inputs: dict[str, bytes], timeout_s: float) -> tuple[np.ndarray, np.ndarray]:
+    with tempfile.TemporaryDirectory(prefix="seadesign-mesh-") as d:
+        d = Path(d)
+        (d / "job.json").write_text(json.dumps(job))
+        for name, data in inputs.items():
+            (d / name).write_bytes(data)
+        try:
+            proc = subprocess.run(
+                [sys.executable, "-m", "seadesign.mesh.worker", str(d)],
+                capture_output=True, text=True, timeout=timeout_s,
+            )
+        except subprocess.TimeoutExpired:
+            raise TimeoutError(f"no mesh within {timeout_s:g} s") from None
+        if proc.returncode != 0 or not (d / "tets.npz").is_file():
+            tail = "\n".join((proc.stderr or proc.stdout).strip().splitlines()[-3:])
+            raise RuntimeError(f"mesher exited with {proc.returncode}: {tail}")
+        with np.load(d / "tets.npz") as out:
+            return out["points"], out["tets"]
+
+
+def mesh_part(
+    solid_or_surface,
+    interfaces: Interfaces,
+    elements_across_beam: float,
+    beam_width_mm: float,
+    cache_dir: str | Path | None = None,
+    backend: str = "gmsh",
+    timeout_s: float = 120.0,
+    max_tets: int = 400_000,
+    retries: int = 2,
+    epsilon: float = 1e-3,
+) -> TetMesh:
+    """Tetrahedralize a part and name its interface surfaces.
+
+    solid_or_surface: a CadQuery solid (mm), or (vertices_mm (n, 3), faces (k, 3)) of a closed
+    surface such as load_stl() returns. Target edge length h = beam_width_mm / elements_across_beam
+    (mm). backend "gmsh" (deterministic, CAD solids only) or "pytetwild" (any closed surface; its
+    edge length and envelope are relative to the bounding-box diagonal: edge_length_fac = h / diag,
+    epsilon as given). Each attempt runs in a child process limited to timeout_s; a failed,
+    timed-out or oversized (> max_tets) attempt is retried `retries` times, then MeshError.
+    Meshes are cached by content under cache_dir (default: cache.default_cache_dir()).
+    """
+    if backend not in BACKENDS:
+        raise MeshError(f"mesh backend {backend!r} is unknown; use one of {', '.join(BACKENDS)}")
+    if not (elements_across_beam > 0 and beam_width_mm > 0):
+        raise MeshError(
+            f"elements_across_beam ({elements_across_beam}) and beam_width_mm ({beam_width_mm}) must be positive"
+        )
+    size_mm = beam_width_mm / elements_across_beam
+    is_cad = hasattr(solid_or_surface, "exportBrep")
+    t0 = time.perf_counter()
+    if backend == "gmsh":
+        if not is_cad:
+            raise MeshError("the gmsh backend needs a CAD solid; mesh surfaces (STL) with backend='pytetwild'")
+        with tempfile.TemporaryDirectory() as d:
+            solid_or_surface.exportBrep(str(Path(d) / "part.brep"))
+            payload = (Path(d) / "part.brep").read_bytes()
+        volume = float(solid_or_surface.Volume())
+        settings = {"backend": backend, "size_mm": size_mm}
+        inputs = {"part.brep": payload}
+        tag_tol_mm = 1e-3 * size_mm
+    else:
+        if is_cad:
+            v, f = tessellate_solid(solid_or_surface, tolerance_mm=min(0.01, size_mm / 50))
+        else:
+            v, f = (np.asarray(a) for a in solid_or_surface)
+        volume = _surface_volume(v, f)
+        diag = float(np.linalg.norm(np.ptp(v, axis=0)))
+        settings = {"backend": backend, "edge_length_fac": size_mm / diag, "epsilon": epsilon}
+        payload = np.ascontiguousarray(v, dtype=np.float64).tobytes() + np.ascontiguousarray(f, dtype=np.int64).tobytes()
+        buf = _npz_bytes(vertices=v, faces=f)
+        inputs = {"surface.npz": buf}
+        tag_tol_mm = 2.0 * epsilon * diag
+    t_geom = time.perf_counter() - t0
+
+    estimate = volume / (REGULAR_TET_VOLUME * size_mm**3)
+    if estimate > max_tets:
+        raise MeshError(
+            f"elements_across_beam={elements_across_beam:g} gives about {estimate:,.0f} tetrahedra, more than "
+            f"max_tets={max_tets:,}; use fewer elements across the beam or raise max_tets"
+        )
+    cache_dir = Path(cache_dir) if cache_dir is not None else cache.default_cache_dir()
+    key = cache.mesh_key(settings, payload)
+    hit = cache.load(cache_dir, key)
+    attempts: list[str] = []
+    t1 = time.perf_counter()
+    if hit is not None:
+        points, tets = hit
+    else:
+        for _ in range(retries + 1):
+            try:
+                points, tets = _run_worker(settings, inputs, timeout_s)
+            except (TimeoutError, RuntimeError) as exc:
+                attempts.append(str(exc))
+                continue
+            if len(tets) > max_tets:
+                attempts.append(f"{len(tets):,} tetrahedra > max_tets={max_tets:,}")
+                continue
+            break
+        else:
+            raise MeshError(
+                f"{backend} failed {len(attempts)} times at {size_mm:.3g} mm ({'; '.join(attempts)}); "
+                "try fewer elements_across_beam, a longer timeout_s or the other backend"
+            )
+        cache.store(cache_dir, key, points, tets)
+    t_tet = time.perf_counter() - t1
+    info = {
+        **settings,
+        "elements_across_beam": elements_across_beam,
+        "beam_width_mm": beam_width_mm,
+        "target_edge_mm": size_mm,
+        "cache_key": key,
+        "cache_hit": hit is not None,
+        "failed_attempts": attempts,
+        "geometry_s": t_geom,
+        "tetrahedralize_s": t_tet,
+    }
+    return build_tetmesh(points, tets, interfaces, tag_tol_mm, info)
+
+
+def _npz_bytes(**arrays: np.ndarray) -> bytes:
+    import io
+
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()

@@ -1,0 +1,57 @@
+"""Content-addressed on-disk store of raw tetrahedral meshes: identical input -> identical mesh."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+CACHE_ENV = "SEADESIGN_CACHE_DIR"
+FORMAT_VERSION = 1  # bump when the stored arrays or the meshing pipeline change meaning
+
+
+def default_cache_dir() -> Path:
+    """$SEADESIGN_CACHE_DIR, else .cache/ at the repository root (source checkout), else ./.cache."""
+    if os.environ.get(CACHE_ENV):
+        return Path(os.environ[CACHE_ENV])
+    repo = Path(__file__).resolve().parents[2]
+    return (repo if (repo / "pyproject.toml").is_file() else Path.cwd()) / ".cache"
+
+
+def mesh_key(settings: dict, payload: bytes) -> str:
+    """sha256 of the meshing settings and the geometry bytes (tessellation or BREP)."""
+    h = hashlib.sha256()
+    h.update(json.dumps({"format": FORMAT_VERSION, **settings}, sort_keys=True).encode())
+    h.update(payload)
+    return h.hexdigest()
+
+
+def _path(cache_dir: Path, key: str) -> Path:
+    return Path(cache_dir) / "meshes" / f"{key}.npz"
+
+
+def load(cache_dir: Path, key: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """Cached (points_mm, tets) or None."""
+    path = _path(cache_dir, key)
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path) as d:
+            return d["points"], d["tets"]
+    except (OSError, ValueError, KeyError):
+        return None  # unreadable entry: remesh and overwrite it
+
+
+def store(cache_dir: Path, key: str, points: np.ndarray, tets: np.ndarray) -> Path:
+    """Write atomically (temporary file + rename) so parallel runs never see half a file."""
+    path = _path(cache_dir, key)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "wb") as f:
+        np.savez(f, points=points, tets=tets)
+    os.replace(tmp, path)
+    return path
