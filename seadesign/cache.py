@@ -1,0 +1,83 @@
+"""Content-addressed cache of sweep stages (geometry, mesh, unit FEA response).
+
+A key is the SHA-256 of the canonical JSON of everything a stage's output depends on: its
+inputs, the key of the stage before it, and the versions of the packages that compute it.
+Entries are pickles written atomically, so an interrupted write never leaves a bad entry.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import pickle
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+DEFAULT_CACHE_DIR = Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
+TRACKED_PACKAGES = ("seadesign", "numpy", "scipy", "cadquery", "pytetwild", "pypardiso")
+
+
+def _plain(obj: Any) -> Any:
+    """JSON-ready form of dataclasses, paths, tuples and floats (floats by repr: exact)."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: _plain(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in sorted(obj.items())}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, float):
+        return repr(obj)
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def digest(*parts: Any, length: int = 32) -> str:
+    """Hex SHA-256 (first `length` characters) of the canonical JSON of `parts`."""
+    text = json.dumps(_plain(list(parts)), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:length]
+
+
+def package_versions(packages: tuple[str, ...] = TRACKED_PACKAGES) -> dict[str, str]:
+    """Installed versions of `packages` ("absent" when not installed)."""
+    out = {}
+    for name in packages:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = "absent"
+    return out
+
+
+@dataclasses.dataclass(frozen=True)
+class Cache:
+    """Pickled stage outputs under root/<stage>/<key[:2]>/<key>.pkl; `enabled=False` stores nothing."""
+
+    root: Path = DEFAULT_CACHE_DIR
+    enabled: bool = True
+
+    def path(self, stage: str, key: str) -> Path:
+        return Path(self.root) / stage / key[:2] / f"{key}.pkl"
+
+    def get(self, stage: str, key: str) -> Any | None:
+        """The stored output, or None when absent or unreadable (then it is recomputed)."""
+        if not self.enabled:
+            return None
+        try:
+            with self.path(stage, key).open("rb") as fh:
+                return pickle.load(fh)
+        except (FileNotFoundError, EOFError, pickle.UnpicklingError):
+            return None
+
+    def put(self, stage: str, key: str, value: Any) -> None:
+        if not self.enabled:
+            return
+        path = self.path(stage, key)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        with tmp.open("wb") as fh:
+            pickle.dump(value, fh, protocol=pickle.HIGHEST_PROTOCOL)
+        tmp.replace(path)

@@ -1,0 +1,153 @@
+"""Run every candidate of a study and collect one result row per candidate.
+
+Rows are written as they arrive, one JSON file per candidate under `<out>/rows/`, named by a
+hash of every input of that candidate (atomic write: temp file + rename). A rerun reuses rows
+whose inputs are unchanged, so an interrupted sweep resumes where it stopped; stages of the
+others come from the content-addressed cache when their own inputs are unchanged.
+Invalid candidates keep their reasons; a candidate whose mesher or solver fails keeps the
+error and the sweep goes on.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from seadesign.cache import Cache, digest, package_versions
+from seadesign.executors import default_jobs, execute
+from seadesign.geometry import GeometryParams
+from seadesign.progress import ProgressDisplay
+from seadesign.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key, load_case_columns
+from seadesign.study import Study
+
+
+@dataclass(frozen=True)
+class Job:
+    """One candidate to evaluate (picklable: it travels to worker processes)."""
+
+    index: int
+    study: Study
+    params: GeometryParams
+    settings: SolverSettings
+    cache: Cache
+    row_key: str
+
+
+@dataclass
+class SweepRun:
+    """The rows of a sweep and how they were obtained."""
+
+    rows: pd.DataFrame
+    computed: list[int] = field(default_factory=list)  # candidate indices evaluated in this run
+    reused: list[int] = field(default_factory=list)  # indices whose stored row was reused
+    wall_s: float = 0.0
+
+
+def candidate_label(params: GeometryParams) -> str:
+    return f"{params.beam_count} beams x {params.beam_thickness_mm:g} mm"
+
+
+def row_key(study: Study, params: GeometryParams, settings: SolverSettings) -> str:
+    """Hash of every input of one candidate's row (geometry, mesh, material, loads, solver, versions)."""
+    return digest("row", fea_key(study, params, settings), geometry_key(study, params), study.load_cases,
+                  study.bearing_radius_mm, study.material)
+
+
+def evaluate(job: Job, sink) -> dict:
+    """One candidate's row. Never raises for a candidate's own failure: the error is the row."""
+    p = job.params
+    row: dict = {"candidate": candidate_label(p), "beam_count": p.beam_count, "beam_thickness_mm": p.beam_thickness_mm,
+                 "status": "ok", "reason": "", "row_key": job.row_key}
+    t0 = time.perf_counter()
+
+    def stage(name: str) -> None:
+        sink.put((job.index, name))
+
+    try:
+        stage("geometry")
+        geo, checked = check_geometry(job.study, p, job.cache)
+        row["volume_mm3"] = geo.volume_mm3
+        row["mass_g"] = geo.volume_mm3 * 1e-9 * job.study.material.density_kg_per_m3 * 1e3
+        if not geo.valid:
+            row.update(status="invalid", reason="; ".join(geo.reasons))
+        else:
+            unit = fea_response(job.study, p, checked, job.settings, job.cache, stage)
+            row.update(unit.mesh_quality)
+            row.update(load_case_columns(unit, job.study))
+    except Exception as exc:  # noqa: BLE001 - a failing candidate is a result, not a crash
+        row.update(status="failed", reason=f"{type(exc).__name__}: {exc}".strip(),
+                   traceback=traceback.format_exc(limit=4))
+    row["elapsed_s"] = time.perf_counter() - t0
+    return row
+
+
+def write_row(folder: Path, row: dict) -> Path:
+    """Atomically write one row as JSON."""
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{row['row_key']}.json"
+    tmp = path.with_suffix(f".{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(row, sort_keys=True))
+    tmp.replace(path)
+    return path
+
+
+def read_row(folder: Path, key: str) -> dict | None:
+    try:
+        return json.loads((folder / f"{key}.json").read_text())
+    except (FileNotFoundError, json.JSONDecodeError):
+        return None
+
+
+def write_table_atomic(df: pd.DataFrame, path: Path) -> None:
+    tmp = path.with_suffix(".tmp" + path.suffix)
+    if path.suffix == ".parquet":
+        df.to_parquet(tmp, index=False)
+    else:
+        df.to_csv(tmp, index=False)
+    tmp.replace(path)
+
+
+def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverSettings(), cache: Cache = Cache(),
+              executor: str = "local", jobs: int | None = None, scheduler: str | None = None,
+              quiet: bool = False, on_row=None) -> SweepRun:
+    """Evaluate every candidate (reusing stored rows with unchanged inputs) and return the rows in
+    study order. `on_row(row)` is called as each computed row is stored (progress hooks, tests)."""
+    t0 = time.perf_counter()
+    rows_dir = Path(out_dir) / "rows"
+    candidates = study.candidates()
+    keys = [row_key(study, p, settings) for p in candidates]
+    rows: dict[int, dict] = {}
+    for i, key in enumerate(keys):
+        stored = read_row(rows_dir, key)
+        if stored is not None:
+            rows[i] = stored
+    reused = sorted(rows)
+    todo = [Job(i, study, candidates[i], settings, cache, keys[i]) for i in range(len(candidates)) if i not in rows]
+    display = ProgressDisplay(len(candidates), len(reused), {j.index: candidate_label(j.params) for j in todo}, quiet)
+    partial_csv = Path(out_dir) / "results.partial.csv"
+    for job, row in execute(evaluate, todo, executor, jobs or default_jobs(), scheduler, display.stage, display.tick):
+        write_row(rows_dir, row)
+        rows[job.index] = row
+        display.finished(job.index, row["status"])
+        write_table_atomic(pd.DataFrame([rows[i] for i in sorted(rows)]), partial_csv)
+        if on_row is not None:
+            on_row(row)
+    display.close()
+    partial_csv.unlink(missing_ok=True)
+    table = pd.DataFrame([rows[i] for i in range(len(candidates))])
+    return SweepRun(table, [j.index for j in todo], reused, time.perf_counter() - t0)
+
+
+def sweep_settings(study: Study, settings: SolverSettings) -> dict:
+    """Settings and versions recorded next to the results."""
+    from dataclasses import asdict
+
+    return {"study": study.name, "study_file": str(study.path), "material": study.material.name,
+            "youngs_modulus_Pa": study.material.youngs_modulus_Pa, "mesh": asdict(study.mesh),
+            "solver": asdict(settings), "ranking": asdict(study.ranking), "versions": package_versions()}
