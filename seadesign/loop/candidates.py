@@ -1,0 +1,255 @@
+"""Candidate effects: small parametric models with physical meaning and units, built over signal roles.
+
+Each `Candidate` maps (data, parameters, value) -> new value. Candidates of the torque path
+(stages below `LOAD_STAGE`) act on the path term of the prediction (the part that passes
+through the spring, see `LoopData.path`); the others act on the whole prediction. The forward
+models are those of the shared effect library (`seadesign.effects`) where its form fits the
+fit: dead-band, temperature softening and gravity call the library's effect
+objects. The rest are written here because the fit needs what the library does not offer:
+signed coefficients (friction, offset, drift, a measured-side delay of either sign), Dahl hysteresis solved
+in closed form over chunks instead of a per-sample Python loop (`dahl`, equal to the library's), a
+vectorised standard-linear-solid lag (`scipy.signal.lfilter` at the median sample interval)
+and thermal softening driven by dissipated energy with one identifiable gain (1/J, the
+library's softening_per_K x loss_factor / heat_capacity).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from scipy.signal import lfilter
+
+from seadesign.effects import DahlHysteresis, DeadBand, GravityLoad, Param, TemperatureSoftening
+from seadesign.loop.table import LoopData
+
+LOAD_STAGE = 7  # stages below act on the path term; from here on the whole prediction
+
+Apply = Callable[[LoopData, np.ndarray, np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One effect the loop can add: key, meaning, roles it needs, stage order, parameters, starts, model."""
+
+    key: str
+    summary: str
+    signature: str
+    roles: tuple[str, ...]
+    stage: int
+    params: Callable[[LoopData], tuple[Param, ...]]
+    starts: Callable[[LoopData], list[list[float]]]
+    apply: Apply
+    directions: tuple[str, ...] = ("stiffness", "compliance")
+    log: tuple[int, ...] = ()  # indices of positive scale parameters fitted in log space
+
+    def applicable(self, data: LoopData) -> bool:
+        return all(r in data.signals for r in self.roles) and data.direction in self.directions
+
+
+def _span(data: LoopData) -> float:
+    return float(np.ptp(data.measured)) or 1.0
+
+
+def _dmax(data: LoopData) -> float:
+    return float(np.max(np.abs(data.signals["displacement"]))) or 1.0
+
+
+def _g(data: LoopData) -> float:
+    return float(data.gain or 1.0)
+
+
+def _u(data: LoopData, role: str) -> str:
+    return data.unit(role)
+
+
+# -- torque path --------------------------------------------------------------------------
+def _dead_band(data, th, path):
+    d, b = data.signals["displacement"], th[0]
+    if data.direction == "stiffness":
+        return path + _g(data) * (DeadBand().apply({"deflection": d}, {"width_rad": b}) - d)
+    return path + _g(data) * np.sign(d) * 0.5 * b  # free travel added to a deflection computed from torque
+
+
+def _scale(data, th, path):
+    return path * (th[0] if data.direction == "stiffness" else 1.0 / th[0])
+
+
+def _cubic(data, th, path):
+    return path + th[0] * data.signals["displacement"] ** 3
+
+
+def dahl(d: np.ndarray, torque: float, stiffness: float, chunk: float = 500.0) -> np.ndarray:
+    """Dahl hysteresis torque z (unit of `torque`) along a displacement record, vectorised.
+
+    The same recursion as `seadesign.effects.DahlHysteresis` (z_n = a_n z_{n-1} + (1 - a_n) s_n tau_h,
+    a_n = exp(-sigma |dd_n| / tau_h)), solved in closed form over chunks in which the decay
+    exponent grows by at most `chunk`, so the exponentials stay finite.
+    """
+    step = np.diff(d, prepend=d[0])
+    c = stiffness / torque
+    decay = np.abs(step) * c
+    v = np.cumsum(decay)
+    b = np.sign(step) * torque * -np.expm1(-decay)
+    if v[-1] > chunk * d.size / 50:  # chunks would be short: the library's per-sample loop is faster
+        return DahlHysteresis().apply({"deflection": d, "torque": np.zeros_like(d)},
+                                      {"torque_Nm": torque, "stiffness_Nm_per_rad": stiffness})
+    z = np.empty_like(v)
+    ids = np.floor(v / chunk)
+    starts = np.flatnonzero(np.diff(ids, prepend=-1.0))
+    z_prev = 0.0
+    for i0, i1 in zip(starts, [*starts[1:], v.size]):
+        r = v[i0:i1] - v[i0]
+        z[i0:i1] = np.exp(-r) * (z_prev * math.exp(-decay[i0]) + np.cumsum(b[i0:i1] * np.exp(r)))
+        z_prev = z[i1 - 1]
+    return z
+
+
+def _hysteresis(data, th, path):
+    return path + dahl(data.smooth("displacement"), th[0], th[1])
+
+
+def lowpass_uniform(x: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
+    """First-order lag of x with time constant tau (s) at the median sample interval, starting at x[0]."""
+    a = math.exp(-float(np.median(np.diff(time))) / tau)
+    y, _ = lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])
+    return y
+
+
+def _viscoelastic(data, th, path):
+    d = data.signals["displacement"]
+    return path + th[0] * (d - lowpass_uniform(d, data.time, th[1]))
+
+
+def leaky_sum(h: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
+    """s_n = s_{n-1} exp(-dt/tau) + h_n at the median sample interval (heat with cooling)."""
+    a = math.exp(-float(np.median(np.diff(time))) / tau)
+    return lfilter([1.0], [1.0, -a], h)
+
+
+def _thermal(data, th, path):
+    if "energy" in data.signals:
+        heat = data.signals["energy"] - data.signals["energy"][0]
+    else:
+        dd = np.diff(data.smooth("displacement"), prepend=data.smooth("displacement")[0])
+        heat = leaky_sum(np.abs(path * dd), data.time, th[1])
+    return path * np.maximum(1.0 - th[0] * heat, 0.05)
+
+
+def _temperature(data, th, path):
+    t = data.signals["temperature"]
+    return TemperatureSoftening().apply({"temperature": t, "torque": path},
+                                        {"softening_per_K": th[0], "reference_temperature_C": float(t[0])})
+
+
+# -- loads and sensors on the whole prediction --------------------------------------------
+def _friction(data, th, y):
+    v = data.signals["velocity"]
+    return y + th[0] * np.tanh(v / th[2]) + th[1] * v
+
+
+def _gravity(data, th, y):
+    return GravityLoad().apply({"angle": data.signals["angle"], "load_torque": y},
+                               {"amplitude_Nm": th[0], "angle_offset_rad": th[1]})
+
+
+def _offset(data, th, y):
+    return y + th[0]
+
+
+def _drift(data, th, y):
+    return y + th[0] * (data.time - data.time[0])
+
+
+def _delay(data, th, y):
+    t = data.time
+    return np.interp(t - th[0], t, y)
+
+
+def _vel_scale(data) -> float:
+    v = np.abs(data.signals["velocity"])
+    return float(np.quantile(v, 0.9)) or 1.0
+
+
+CANDIDATES: tuple[Candidate, ...] = (
+    Candidate(
+        "dead_band", "dead zone of total width b in the displacement (spring dead-band or backlash)",
+        "flat/S-shape near zero displacement", ("displacement",), 0,
+        lambda d: (Param("width", _u(d, "displacement"), 0.0, 0.0, min(0.5, _dmax(d)), "total width b of the dead zone"),),
+        lambda d: [[0.05 * _dmax(d)], [0.2 * _dmax(d)]], _dead_band),
+    Candidate(
+        "stiffness_scale", "true / modelled stiffness (wrong modulus, infill or geometry)",
+        "residual proportional to the prediction", ("displacement",), 1,
+        lambda d: (Param("scale", "1", 1.0, 0.01, 100.0, "ratio of true to modelled stiffness"),),
+        lambda d: [[1.0], [0.1], [10.0]], _scale),
+    Candidate(
+        "cubic_stiffening", "odd cubic term k3 d^3 (k3 > 0 stiffening, < 0 softening)",
+        "odd cubic residual vs displacement", ("displacement",), 2,
+        lambda d: (Param("k3", f"{d.measured_unit}/{_u(d, 'displacement')}^3", 0.0, -10 * _span(d) / _dmax(d) ** 3,
+                         10 * _span(d) / _dmax(d) ** 3, "cubic stiffness coefficient"),),
+        lambda d: [[0.0]], _cubic),
+    Candidate(
+        "hysteresis", "Dahl hysteresis: torque z, dz/dd = sigma (1 - z sign(dd) / tau_h)",
+        "loop vs displacement that stays open at low frequency", ("displacement",), 3,
+        lambda d: (Param("torque", d.measured_unit, 0.01 * _span(d), 1e-6, min(20.0, _span(d)), "saturation torque tau_h"),
+                   Param("stiffness", f"{d.measured_unit}/{_u(d, 'displacement')}", abs(_g(d)), 1e-3, 1e5,
+                         "initial slope sigma after a reversal")),
+        lambda d: [[0.02 * _span(d), 3 * abs(_g(d))], [0.02 * _span(d), 30 * abs(_g(d))]], _hysteresis,
+        directions=("stiffness",), log=(0, 1)),
+    Candidate(
+        "viscoelastic", "standard linear solid: Maxwell arm k2 with relaxation time tr",
+        "phase lead; loop that vanishes at low and high frequency", ("displacement",), 4,
+        lambda d: (Param("maxwell_stiffness", f"{d.measured_unit}/{_u(d, 'displacement')}", 0.0, 0.0,
+                         10 * abs(_g(d)) + _span(d) / _dmax(d), "stiffness k2 of the Maxwell arm"),
+                   Param("relaxation_time", "s", 1.0, 1e-3, 1e3, "relaxation time tr")),
+        lambda d: [[0.1 * abs(_g(d)), tr] for tr in (0.05, 0.5, 5.0)], _viscoelastic,
+        directions=("stiffness",), log=(1,)),
+    Candidate(
+        "thermal_softening", "stiffness x (1 - c H), H = heat from dissipated energy with cooling time tc",
+        "drift that tracks cumulative dissipated energy", ("displacement",), 5,
+        lambda d: (Param("softening_per_J", "1/J", 0.0, 0.0, 1.0, "relative stiffness loss c per joule of retained heat"),
+                   Param("cooling_time", "s", 600.0, 1.0, 1e6, "cooling time constant tc")),
+        lambda d: [[1e-3, tc] for tc in (30.0, 300.0, 3000.0)], _thermal,
+        directions=("stiffness",), log=(1,)),
+    Candidate(
+        "temperature_softening", "stiffness x (1 - a (T - T0)), T0 the first sample's temperature",
+        "drift that tracks temperature", ("temperature",), 6,
+        lambda d: (Param("softening_per_K", "1/K", 0.0, 0.0, 0.05, "relative stiffness loss a per kelvin"),),
+        lambda d: [[0.005]], _temperature, directions=("stiffness",)),
+    Candidate(
+        "friction", "Coulomb + viscous: Fc tanh(v / vs) + Fv v",
+        "jump at v = 0 and slope vs v", ("velocity",), 7,
+        lambda d: (Param("coulomb", d.measured_unit, 0.0, -_span(d), _span(d), "Coulomb friction Fc"),
+                   Param("viscous", f"{d.measured_unit}/({_u(d, 'velocity')})", 0.0, -100 * _span(d) / _vel_scale(d),
+                         100 * _span(d) / _vel_scale(d), "viscous coefficient Fv"),
+                   Param("smoothing", _u(d, "velocity"), 0.05 * _vel_scale(d), 1e-4 * _vel_scale(d),
+                         _vel_scale(d), "velocity vs below which the Coulomb term fades")),
+        lambda d: [[0.01 * _span(d), 0.0, 0.02 * _vel_scale(d)], [0.01 * _span(d), 0.0, 0.2 * _vel_scale(d)]],
+        _friction, log=(2,)),
+    Candidate(
+        "gravity", "gravity load A sin(angle + phi), A = m g l_c",
+        "follows the link angle, present at v = 0", ("angle",), 8,
+        lambda d: (Param("amplitude", d.measured_unit, 0.0, 0.0, min(100.0, 2 * _span(d)), "m g l_c"),
+                   Param("angle_offset", "rad", 0.0, -math.pi, math.pi, "angle phi at which the load vanishes, negated")),
+        lambda d: [[0.1 * _span(d), phi] for phi in (-2.0, 0.0, 2.0)], _gravity),
+    Candidate(
+        "sensor_offset", "constant offset c of the measured channel",
+        "mean shift", (), 9,
+        lambda d: (Param("offset", d.measured_unit, 0.0, -_span(d), _span(d), "offset c"),),
+        lambda d: [[0.0]], _offset),
+    Candidate(
+        "sensor_drift", "linear drift r (t - t0) of the measured channel",
+        "ramp over the recording", ("time",), 10,
+        lambda d: (Param("rate", f"{d.measured_unit}/s", 0.0, -10 * _span(d) / np.ptp(d.time),
+                         10 * _span(d) / np.ptp(d.time), "drift rate r"),),
+        lambda d: [[0.0]], _drift),
+    Candidate(
+        "sensor_delay", "measured(t) = prediction(t - td); td < 0: the input sensor lags",
+        "residual about -td x rate; cross-correlation peak at a non-zero lag", ("time",), 11,
+        lambda d: (Param("delay", "s", 0.0, -1.0, 1.0, "delay td of the measured channel behind the prediction"),),
+        lambda d: [[td] for td in (-0.1, -0.02, 0.02, 0.1)], _delay),
+)
+
+LIBRARY: dict[str, Candidate] = {c.key: c for c in CANDIDATES}
