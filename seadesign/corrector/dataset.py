@@ -8,6 +8,9 @@ of recordings into one pooled sample table for a task:
   output = motor position at t+1.
 - ``inverse`` (better posed for a controller): target = Hall position at t+1 (the position
   the command should produce), inputs at t, output = motor position at t+1.
+- ``command`` (the whole actuator's inverse model): target = Hall position at t+1, inputs at t,
+  output = the position command sent at t (channel `command_pos_rad`; rows without a recorded
+  command are skipped). Unlike the motor position, this includes the servo's own lag.
 
 Knees are pooled. With ``positive=True`` right-knee samples have every signed knee channel and
 the output sign-flipped, so both knees look alike (thesis sec. 6.1). ``history`` adds the
@@ -27,7 +30,8 @@ from seadesign.corrector.modalities import MIRRORED_CHANNELS, MODALITIES, channe
 from seadesign.errors import DataError, SeadesignError
 
 KNEES = ("left", "right")
-TASKS = ("thesis", "inverse")
+TASKS = ("thesis", "inverse", "command")
+COMMAND = "command_pos_rad"  # optional channel: position command sent at t, rad (NaN where none)
 ALL_CHANNELS = channels(tuple(MODALITIES))
 
 
@@ -146,7 +150,13 @@ def _knee_rows(rec: Recording, knee: str, spec: DatasetSpec) -> tuple[np.ndarray
     target_t = hall[t] if spec.task == "thesis" else hall[t + 1]
     X = rows(t, target_t)
     X_next = rows(t + 1, hall[t + 1])  # the state the command leads to (Siamese pair)
-    y = motor[t + 1]
+    if spec.task == "command":
+        if COMMAND not in ch:
+            raise DataError(f"recording {rec.name} has no position commands; task 'command' needs them "
+                            "(use --task thesis or inverse)")
+        y = ch[COMMAND][t]
+    else:
+        y = motor[t + 1]
     sign = -1.0 if (spec.positive and knee == "right") else 1.0
     if sign < 0:
         names = spec.feature_names()

@@ -1,6 +1,7 @@
 """Open-loop evaluation on recordings: each corrector sees the recorded inputs step by step
 (through the same online path it would use on the robot) and its command at t is compared with
-the recorded motor position at t+1, on the held-out rows of a split.
+the task's label (motor position at t+1, or the command sent at t for task "command"), on the
+held-out rows of a split.
 
 Metrics per knee and pooled, in rad: MSE (rad^2), MAE, MAPE (% of |motor position|), peak |error|;
 plus MSE in the thesis's normalised units (positions / pi) for comparison with its tables.
@@ -21,7 +22,7 @@ ALL = channels(tuple(MODALITIES))
 def run_open_loop(corrector: Corrector, rec: Recording, task: str) -> dict[str, np.ndarray]:
     """Commands for every step t < T-1 of `rec` (robot frame, rad), per knee; index = step t.
 
-    The target follows `task` ("thesis": Hall position at t; "inverse": at t+1); a trained
+    The target follows `task` ("thesis": Hall position at t; otherwise at t+1); a trained
     corrector uses the task it was trained for.
     """
     spec = getattr(corrector, "spec", None)
@@ -57,8 +58,7 @@ def open_loop_table(correctors: list[Corrector], recordings: list[Recording], ds
     Also returns, per corrector, the command and truth arrays on those rows (for plots).
     """
     rec_of, knee_of, step_of = ds.recording[rows], ds.knee[rows], ds.step[rows]
-    truth = np.array([recordings[r].knees[KNEES[k]]["motor_pos_rad"][s + 1]
-                      for r, k, s in zip(rec_of, knee_of, step_of)])
+    truth = ds.y[rows] * ds.sign[rows]  # the task's label in the robot frame
     table, traces = [], {}
     for c in correctors:
         runs = [run_open_loop(c, rec, ds.spec.task) for rec in recordings]

@@ -8,7 +8,7 @@ here: the corrector dataset does its own mirroring ("positive") so that it can u
 
 Column mapping (per knee side l / r): `<s>_knee_pos` -> motor_pos_rad, `<s>_hall_pos` ->
 hall_pos_rad, `<s>_knee_vel` -> motor_vel_rad_per_s, `<s>_hall_vel` -> hall_vel_rad_per_s,
-`<s>_knee_eff` -> effort_Nm; the knee's own foot pressure cells first, then the other foot's.
+`<s>_knee_eff` -> effort_Nm, `<s>_cmd_pos` -> command_pos_rad (NaN without a command); the knee's own foot pressure cells first, then the other foot's.
 Rows removed by the cleaning and time gaps above `GAP_FACTOR` x the median step split a recording
 into segments that no sample pairs across.
 """
@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from seadesign.corrector.dataset import Recording
+from seadesign.corrector.dataset import COMMAND, Recording
 from seadesign.corrector.modalities import IMU_CHANNELS, PRESSURE_CHANNELS
 from seadesign.data import clean, read_recording
 from seadesign.errors import DataError
@@ -58,6 +58,7 @@ def recording_from_frame(df: pd.DataFrame, name: str, setting: str = "recorded")
     for knee, s in _SIDES.items():
         other = "r" if s == "l" else "l"
         ch = {dst: df[f"{s}_{src}"].to_numpy(dtype=float) for src, dst in _KNEE_MAP.items()}
+        ch[COMMAND] = np.where(df["has_command"].to_numpy(dtype=bool), df[f"{s}_cmd_pos"].to_numpy(dtype=float), np.nan)
         ch.update(zip(IMU_CHANNELS, imu.T))
         cells = np.column_stack([df[[f"{s}_pressure_{i}" for i in range(4)]].to_numpy(float),
                                  df[[f"{other}_pressure_{i}" for i in range(4)]].to_numpy(float)])
@@ -69,14 +70,19 @@ def recording_from_frame(df: pd.DataFrame, name: str, setting: str = "recorded")
 
 def load_recording(path: str | Path) -> tuple[Recording, list[dict]]:
     """Read and clean one recording file; returns the Recording and the cleaning log."""
-    df = read_recording(path)
+    return recording_from_table(read_recording(path), Path(path).stem)
+
+
+def recording_from_table(df: pd.DataFrame, name: str) -> tuple[Recording, list[dict]]:
+    """Clean a robot-format table (`read_recording` or the simulator's) and convert it."""
+    df = df.copy()
     df["source_row"] = np.arange(len(df))
     cells = [c for c in df.columns if "_pressure_" in c]
     hanging = bool((df[cells].to_numpy(dtype=float).sum(axis=1) < PRESSURE_THRESHOLD).all())
     res = clean(df, pressure_threshold=PRESSURE_THRESHOLD, keep_lifted=hanging, normalise=False, positive=False)
     meta = df.attrs.get("metadata") or {}
     setting = str(meta.get("setting", "hanging" if hanging else "ground"))
-    return recording_from_frame(res.table, Path(path).stem, setting), res.log
+    return recording_from_frame(res.table, name, setting), res.log
 
 
 def load_recordings(paths: list[str | Path]) -> list[Recording]:

@@ -31,6 +31,7 @@ def linear_spring_recording(k_Nm_per_rad: float, duration_s: float = 30.0, rate_
         ch = {
             "motor_pos_rad": sign * motor, "hall_pos_rad": sign * hall, "effort_Nm": sign * effort,
             "motor_vel_rad_per_s": sign * np.gradient(motor, t), "hall_vel_rad_per_s": sign * np.gradient(hall, t),
+            "command_pos_rad": sign * np.append(motor[1:], motor[-1]),  # an ideal servo reaches it next sample
         }
         for i, c in enumerate(IMU_CHANNELS):
             ch[c] = 0.05 * np.sin(w * t + i) + 0.01 * rng.standard_normal(len(t))
