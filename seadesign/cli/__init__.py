@@ -35,3 +35,4 @@ def main() -> None:
 from seadesign.cli import design_cmds  # noqa: E402,F401
 from seadesign.cli import corrector_cmds  # noqa: E402,F401
 from seadesign.cli import data_cmds  # noqa: E402,F401
+from seadesign.cli import sweep_cmds  # noqa: E402,F401

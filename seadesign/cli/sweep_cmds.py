@@ -1,0 +1,99 @@
+"""`seadesign sweep`: run every candidate of a study, rank, and write the report and spring.json."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+from pathlib import Path
+
+import click
+
+from seadesign.cli import main
+from seadesign.errors import ConfigError
+from seadesign.study import DEFAULT_STUDY, Study, load_study
+
+
+def apply_calibration(study: Study, path: Path) -> tuple[Study, str]:
+    """The study with its material modulus replaced from a calibration JSON that holds either
+    `stiffness_scale` (multiplies E, > 0) or `youngs_modulus_Pa` (replaces E, > 0)."""
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ConfigError(f"--calibration {path}: cannot be read as JSON ({exc})") from None
+    keys = [k for k in ("stiffness_scale", "youngs_modulus_Pa") if isinstance(data, dict) and k in data]
+    if len(keys) != 1:
+        raise ConfigError(f"--calibration {path}: needs exactly one of 'stiffness_scale' (factor on E) or "
+                          f"'youngs_modulus_Pa' (Pa), found {keys or 'neither'}")
+    value = data[keys[0]]
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not value > 0:
+        raise ConfigError(f"--calibration {path}: '{keys[0]}' must be a positive number, got {value!r}")
+    scale = value if keys[0] == "stiffness_scale" else value / study.material.youngs_modulus_Pa
+    note = f"calibrated from {Path(path).name}: E x {scale:.4g}"
+    return dataclasses.replace(study, material=study.material.scaled(scale, note)), note
+
+
+@main.command()
+@click.argument("study", default=str(DEFAULT_STUDY.stem), required=False)
+@click.option("--jobs", type=click.IntRange(min=1), default=None,
+              help="Worker processes (count); default: all cores. 1 runs in this process.")
+@click.option("--quiet", is_flag=True, help="No progress display (for scripts); the summary is still printed.")
+@click.option("--executor", type=click.Choice(["local", "dask"]), default="local", show_default=True,
+              help="local process pool, or a Dask distributed cluster.")
+@click.option("--scheduler", default=None, metavar="HOST:PORT",
+              help="Dask scheduler address (with --executor dask); a LocalCluster of --jobs workers when omitted.")
+@click.option("--export-all", is_flag=True, help="STL + STEP (mm) of every valid candidate, not only the chosen one.")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=Path("exports"),
+              show_default=True, help="Output root (directory); files go to OUT/<study>/.")
+@click.option("--calibration", type=click.Path(dir_okay=False, exists=True, path_type=Path), default=None,
+              help="JSON with 'stiffness_scale' (factor, -) or 'youngs_modulus_Pa' (Pa) replacing the material's "
+                   "Young's modulus; the choice with and without it is printed.")
+@click.option("--cache-dir", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Stage cache directory; default $SEADESIGN_CACHE or ~/.cache/seadesign.")
+@click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0), default=0.01, show_default=True,
+              help="STL chordal tolerance in mm.")
+def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: str | None, export_all: bool,
+          out_dir: Path, calibration: Path | None, cache_dir: Path | None, tolerance_mm: float) -> None:
+    """Run every candidate of STUDY (geometry, validity, mesh, both load cases), rank them and write
+    results.parquet/csv, plots, report.html/md, STL/STEP and spring.json to OUT/<study>/.
+
+    Interrupted sweeps resume; unchanged stages come from the cache. Units: lengths mm where
+    named, otherwise SI (N, Nm, rad, Pa).
+    """
+    from seadesign.cache import DEFAULT_CACHE_DIR, Cache
+    from seadesign.rank import rank
+    from seadesign.report import write_outputs
+    from seadesign.stages import SolverSettings
+    from seadesign.sweep import run_sweep, sweep_settings
+
+    logging.basicConfig(level=logging.WARNING, format="%(message)s")
+    s = load_study(study)
+    baseline = None
+    if calibration is not None:
+        baseline = s
+        s, note = apply_calibration(s, calibration)
+        click.echo(note)
+    cache = Cache(cache_dir or DEFAULT_CACHE_DIR)
+    solver = SolverSettings()
+    folder = out_dir / s.name
+    run = run_sweep(s, folder, settings=solver, cache=cache, executor=executor, jobs=jobs, scheduler=scheduler,
+                    quiet=quiet)
+    ranked, choice = rank(run.rows, s)
+    settings = sweep_settings(s, solver)
+    written = write_outputs(s, ranked, choice, folder, settings, solver=solver, cache=cache, export_all=export_all,
+                            tolerance_mm=tolerance_mm)
+    counts = ranked["status"].value_counts().to_dict()
+    click.echo(f"{len(ranked)} candidates ({', '.join(f'{n} {k}' for k, n in counts.items())}); "
+               f"{len(run.computed)} computed, {len(run.reused)} reused, {run.wall_s:.1f} s")
+    click.echo(choice.explanation)
+    if baseline is not None:
+        base_run = run_sweep(baseline, folder, settings=solver, cache=cache,
+                             executor=executor, jobs=jobs, scheduler=scheduler, quiet=quiet)
+        base_ranked, base_choice = rank(base_run.rows, baseline)
+        before = base_ranked.loc[base_choice.index, "candidate"] if base_choice.index is not None else "none"
+        after = ranked.loc[choice.index, "candidate"] if choice.index is not None else "none"
+        click.echo(f"calibration: choice {'unchanged' if before == after else 'changes'}: {before} -> {after}")
+    for kind, paths in written.items():
+        for p in paths:
+            if not quiet:
+                click.echo(f"wrote {p}")

@@ -1,0 +1,84 @@
+"""report.md and a self-contained report.html (images inlined as base64) of a ranked sweep."""
+
+from __future__ import annotations
+
+import base64
+import html
+import importlib.util
+from pathlib import Path
+
+import pandas as pd
+
+SUMMARY_COLUMNS = [
+    "candidate", "status", "mass_g", "k_Nm_per_rad", "k_rel_error", "stall_bearing_displacement_mm",
+    "stall_foot_error_mm", "impact_reaction_per_bolt_N", "thesis_reaction_N", "thesis_displacement_mm",
+    "stall_von_mises_max_MPa", "impact_von_mises_max_MPa", "standing_deflection_deg", "impact_energy_J",
+    "impact_gearbox_torque_Nm", "max_rotation_rad", "extrapolation", "feasible", "pareto", "score", "rank",
+    "failed_constraints", "reason",
+]
+
+
+def summary_table(t: pd.DataFrame) -> pd.DataFrame:
+    cols = [c for c in SUMMARY_COLUMNS if c in t.columns]
+    return t[cols].round(4)
+
+
+def sections(study, t: pd.DataFrame, explanation: str, settings: dict) -> list[tuple[str, str]]:
+    """(heading, markdown-free text) pairs shared by both documents."""
+    removed = t[t["n_failed_constraints"] > 0]
+    counts = {}
+    for text in removed["failed_constraints"]:
+        for c in filter(None, text.split("; ")):
+            counts[c] = counts.get(c, 0) + 1
+    lc, rk = study.load_cases, study.ranking
+    return [
+        ("Study", f"{study.name}: {study.description}. Material {study.material.name} "
+                  f"(E = {study.material.youngs_modulus_Pa / 1e6:.4g} MPa, yield {study.material.yield_strength_Pa / 1e6:.3g} MPa). "
+                  f"Stall torque {lc.stall_torque_Nm:g} Nm on the hub; impact torque {lc.impact_torque_Nm:.2f} Nm on the "
+                  f"backplate side; standing knee torque {study.robot.standing_knee_torque_Nm:.2f} Nm. "
+                  f"Mesh: {study.mesh.elements_across_beam:g} elements across a beam ({study.mesh.backend})."),
+        ("Choice", explanation),
+        ("Constraints that removed candidates",
+         "; ".join(f"{c}: {n} candidates" for c, n in counts.items()) or "none"),
+        ("Objectives", "accuracy = stall bearing displacement (mm); protection = peak torque a foot strike drives "
+                       f"into the gearbox, w sqrt(k J) with w = {rk.impact_speed_m_per_s:g} m/s / lower leg and "
+                       f"J = {rk.knee_inertia_kg_m2:g} kg m^2; weights {rk.weight_accuracy:g} / {rk.weight_protection:g}. "
+                       "For a linear spring both depend on k alone, so the Pareto front holds every pool candidate "
+                       "with a distinct k and the weighted score picks the point on it."),
+        ("Model range", f"Rotations above {rk.small_deflection_limit_rad:g} rad are flagged as extrapolation of the "
+                        f"linear model ({int(t['extrapolation'].sum())} of {len(t)} candidates)."),
+        ("Settings and versions", ", ".join(f"{k}: {v}" for k, v in settings.items())),
+    ]
+
+
+def write_markdown(path: Path, study, t: pd.DataFrame, explanation: str, settings: dict, images: dict[str, Path]) -> Path:
+    lines = [f"# Design sweep: {study.name}", ""]
+    for head, text in sections(study, t, explanation, settings):
+        lines += [f"## {head}", "", text, ""]
+    lines += ["## Results", "", summary_table(t).to_markdown(index=False) if _has_tabulate() else
+              "```\n" + summary_table(t).to_string(index=False) + "\n```", ""]
+    lines += ["## Figures", ""] + [f"![{title}]({p.name})" for title, p in images.items()] + [""]
+    path.write_text("\n".join(lines))
+    return path
+
+
+def write_html(path: Path, study, t: pd.DataFrame, explanation: str, settings: dict, images: dict[str, Path]) -> Path:
+    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>Design sweep: {html.escape(study.name)}</title>",
+             "<style>body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse;"
+             "font-size:11px}td,th{border:1px solid #ccc;padding:2px 4px}img{max-width:100%}</style></head><body>",
+             f"<h1>Design sweep: {html.escape(study.name)}</h1>"]
+    for head, text in sections(study, t, explanation, settings):
+        parts.append(f"<h2>{html.escape(head)}</h2><p>{html.escape(text)}</p>")
+    parts.append("<h2>Results</h2>" + summary_table(t).to_html(index=False, na_rep=""))
+    parts.append("<h2>Figures</h2>")
+    for title, p in images.items():
+        data = base64.b64encode(p.read_bytes()).decode()
+        parts.append(f"<h3>{html.escape(title)}</h3><img alt='{html.escape(title)}' src='data:image/png;base64,{data}'>")
+    parts.append("</body></html>")
+    path.write_text("\n".join(parts))
+    return path
+
+
+def _has_tabulate() -> bool:
+    """pandas' to_markdown needs the optional tabulate package."""
+    return importlib.util.find_spec("tabulate") is not None
