@@ -8,12 +8,16 @@ import click
 
 from seadesign.cli import main
 from seadesign.corrector.dataset import TASKS, DatasetSpec
+from seadesign.corrector.export import versions
+from seadesign.corrector.iterative import iterate as run_iterations
 from seadesign.corrector.models import MODEL_KINDS
 from seadesign.corrector.recordings import load_recordings
+from seadesign.corrector.report import write_table
 from seadesign.corrector.splits import SPLITS
 from seadesign.corrector.train import TrainConfig
 from seadesign.corrector.workflow import DEFAULT_HISTORY, candidate_name, evaluate_bundles, train_bundle
 from seadesign.handoff import load_spring
+from seadesign.twin import thesis_protocol
 
 
 def _models(text: str) -> list[str]:
@@ -81,14 +85,62 @@ def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: 
               help="output folder; default exports/<study>/corrector/evaluation")
 @click.option("--kp", type=float, default=0.2, show_default=True, help="PI baseline proportional gain")
 @click.option("--ki", type=float, default=0.1, show_default=True, help="PI baseline integral gain, 1/s")
+@click.option("--closed-loop", "closed_loop", default="hanging,ground", show_default=True,
+              help="simulator settings for the closed-loop table (comma-separated; 'none' to skip)")
+@click.option("--trial-s", type=float, default=10.0, show_default=True, help="closed-loop trial duration, s")
 def evaluate(bundles: tuple[str, ...], data: tuple[str, ...], json_path: str | None, out: str | None,
-             kp: float, ki: float) -> None:
-    """Score corrector bundles against the baselines; write tables (CSV, Markdown[, JSON]) and plots."""
-    res = evaluate_bundles(list(bundles), list(data), out, json_path, kp, ki)
+             kp: float, ki: float, closed_loop: str, trial_s: float) -> None:
+    """Score corrector bundles against the baselines, open loop on recordings and closed loop in the
+    knee simulator; write tables (CSV, Markdown[, JSON]) and plots."""
+    settings = tuple(s.strip() for s in closed_loop.split(",") if s.strip() and s.strip() != "none")
+    res = evaluate_bundles(list(bundles), list(data), out, json_path, kp, ki, settings, trial_s)
     both = [r for r in res["open_loop"] if r["knee"] == "both"]
     click.echo(f"open loop ({res['settings']['rows']}):")
     for r in both:
         click.echo(f"  {r['candidate']:<45} MAE {r['mae_rad']:.4f} rad  MSE {r['mse_rad2']:.4g} rad^2  "
                    f"peak {r['peak_rad']:.3f} rad")
+    for r in res.get("closed_loop", []):
+        if "mean_abs_error_rad" in r:
+            flags = ", ".join(f for f in ("unstable", "oscillating") if r.get(f"{f}_flag"))
+            click.echo(f"  closed loop {r['setting']:<8} {r['candidate']:<45} mean |Hall error| "
+                       f"{r['mean_abs_error_rad']:.4f} rad  peak {r['peak_abs_error_rad']:.3f} rad  {flags}")
     for f in res["files"]:
         click.echo(f"wrote {f}")
+
+
+@main.command()
+@click.option("--spring", "spring_path", required=True, type=click.Path(dir_okay=False), help="spring.json")
+@click.option("--data", "data", multiple=True, type=click.Path(exists=True, dir_okay=False),
+              help="starting recordings (none: start from a simulated run without correction)")
+@click.option("--model", type=click.Choice(MODEL_KINDS), default="mlp", show_default=True)
+@click.option("--modalities", default="velocity_effort", show_default=True)
+@click.option("--task", type=click.Choice(TASKS), default="command", show_default=True)
+@click.option("--positive/--normal", default=True, show_default=True)
+@click.option("--history", type=int, default=None, help=f"past samples (default 0; {DEFAULT_HISTORY} for history)")
+@click.option("--rounds", type=int, default=2, show_default=True, help="retraining rounds after round 0")
+@click.option("--setting", type=click.Choice(["hanging", "ground"]), default="hanging", show_default=True)
+@click.option("--trial-s", type=float, default=10.0, show_default=True, help="trial duration, s")
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--max-seconds", type=float, default=TrainConfig.max_seconds, show_default=True, help="s per round")
+@click.option("-o", "--out", "out", type=click.Path(file_okay=False), default=None,
+              help="output folder; default exports/<study>/corrector/iterative")
+def iterate(spring_path: str, data: tuple[str, ...], model: str, modalities: str, task: str, positive: bool,
+            history: int | None, rounds: int, setting: str, trial_s: float, seed: int, max_seconds: float,
+            out: str | None) -> None:
+    """Iterative training: retrain on simulator runs recorded with the current corrector in the loop."""
+    spring = load_spring(spring_path)
+    h = history if history is not None else (DEFAULT_HISTORY if model == "history" else 0)
+    spec = DatasetSpec(task, modalities, h, positive)
+    cfg = TrainConfig(model=model, seed=seed, max_seconds=max_seconds)
+    table, _ = run_iterations(spring, load_recordings(list(data)), spec, cfg, rounds, setting,
+                              thesis_protocol(trial_s), seed=seed)
+    folder = Path(out) if out else Path("exports") / spring["study"] / "corrector" / "iterative"
+    files = write_table(table, folder, "iterative", {"spec": spec.to_dict(), "training": cfg.__dict__,
+                                                    "setting": setting, "trial_s": trial_s,
+                                                    "data": [str(Path(d).resolve()) for d in data],
+                                                    "versions": versions()})
+    for r in table.to_dict("records"):
+        click.echo(f"round {r['round']}: mean |Hall error| {r['mean_abs_error_rad']:.4f} rad, peak "
+                   f"{r['peak_abs_error_rad']:.3f} rad, unstable {r['unstable_flag']}, "
+                   f"oscillating {r['oscillating_flag']}")
+    click.echo(f"wrote {files['csv']} and {files['md']}")

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from seadesign.corrector.closedloop import closed_loop_table
 from seadesign.corrector.dataset import CorrectorDataset, DatasetSpec, Recording, build_dataset
 from seadesign.corrector.evaluate import open_loop_table
 from seadesign.corrector.export import export_bundle, input_list, load_meta, load_numpy, versions
@@ -26,6 +27,7 @@ from seadesign.corrector.splits import Split, make_split
 from seadesign.corrector.train import TrainConfig, TrainResult, fit
 from seadesign.errors import SeadesignError
 from seadesign.handoff import load_spring
+from seadesign.twin import thesis_protocol
 
 DEFAULT_HISTORY = 3  # samples, for the history model when no --history is given
 
@@ -124,11 +126,15 @@ def evaluation_rows(meta: dict, data_paths: list[str | Path], recs: list[Recordi
 
 
 def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path], out_dir: str | Path | None = None,
-                     json_path: str | Path | None = None, kp: float = 0.2, ki: float = 0.1) -> dict[str, Any]:
-    """Open-loop table of all bundles vs the baselines (none, PI, feed-forward), plots and settings.
+                     json_path: str | Path | None = None, kp: float = 0.2, ki: float = 0.1,
+                     closed_loop: tuple[str, ...] = ("hanging", "ground"), trial_s: float = 10.0,
+                     seed: int = 0) -> dict[str, Any]:
+    """Open-loop table of all bundles vs the baselines (none, PI, feed-forward), plots and settings;
+    then, for each setting in `closed_loop`, the closed-loop table in the knee simulator (thesis
+    protocol, `trial_s` s per trial) built from the spring.json the first bundle was trained with.
 
-    Rows scored: see `evaluation_rows` (decided by the first bundle). Default output folder:
-    exports/<study>/corrector/evaluation.
+    Rows scored open loop: see `evaluation_rows` (decided by the first bundle). Default output
+    folder: exports/<study>/corrector/evaluation.
     """
     bundles = find_bundles(bundle_paths)
     nets = [load_corrector(b) for b in bundles]
@@ -150,6 +156,15 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
                           for b, (_, m) in zip(bundles, nets)}, out / "training_curves.png")]
     result = {"open_loop": table.to_dict("records"), "settings": context,
               "files": [str(p) for p in [*files.values(), *plots]]}
+    if closed_loop:
+        spring = load_spring(ref_meta["spring"]["path"])
+        cl_table, _ = closed_loop_table(correctors, spring, closed_loop, thesis_protocol(trial_s), seed=seed)
+        cl_context = {"protocol": f"thesis: 6 directions x 3 speeds, {trial_s:g} s each", "seed": seed,
+                      "spring": ref_meta["spring"], "versions": versions()}
+        cl_files = write_table(cl_table, out, "closed_loop", cl_context)
+        result["closed_loop"] = cl_table.to_dict("records")
+        result["closed_loop_settings"] = cl_context
+        result["files"] += [str(p) for p in cl_files.values()]
     if json_path:
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
         Path(json_path).write_text(json.dumps(result, indent=2, default=str) + "\n")

@@ -1,0 +1,90 @@
+"""`seadesign train` / `evaluate` end to end on a simulated recording, and the real recordings when present."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from seadesign.cli import main
+from seadesign.data import write_recording
+from seadesign.twin import Trial, simulate
+from tests.conftest import shared_path
+
+
+def _spring(tmp_path, spring_dict):
+    from seadesign.handoff import write_spring
+
+    return write_spring(spring_dict, tmp_path / "spring.json")
+
+
+def _recording(tmp_path, spring_dict):
+    table, meta = simulate(spring_dict, [Trial("front", 0.1, 6.0), Trial("back_right", 0.2, 6.0)], seed=2)
+    return write_recording(table, tmp_path / "sim_walk.csv", metadata=meta)
+
+
+def test_train_refuses_a_spring_file_that_fails_its_schema(tmp_path, spring_dict):
+    csv = _recording(tmp_path, spring_dict)
+    spring_dict["k_Nm_per_rad"] = -1.0
+    bad = tmp_path / "bad_spring.json"
+    bad.write_text(json.dumps(spring_dict))
+    res = CliRunner().invoke(main, ["train", "--spring", str(bad), "--data", str(csv), "-o", str(tmp_path / "m")])
+    assert res.exit_code == 2
+    assert "k_Nm_per_rad" in res.output
+    assert not (tmp_path / "m").exists()
+
+
+def test_train_then_evaluate_writes_tables_plots_and_json(tmp_path, spring_dict):
+    spring = _spring(tmp_path, spring_dict)
+    csv = _recording(tmp_path, spring_dict)
+    out = tmp_path / "models"
+    res = CliRunner().invoke(main, ["train", "--spring", str(spring), "--data", str(csv), "--model", "mlp,siamese",
+                                    "--max-epochs", "4", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    bundles = sorted(p.name for p in out.iterdir())
+    assert bundles == ["mlp-positive-velocity_effort-thesis", "siamese-positive-velocity_effort-thesis"]
+    meta = json.loads((out / bundles[0] / "meta.json").read_text())
+    assert meta["k_Nm_per_rad"] == spring_dict["k_Nm_per_rad"] and meta["split"]["split"] == "time_blocks"
+    assert meta["input_units"][0] == "rad" and "torch" in meta["versions"]
+
+    ev = tmp_path / "eval"
+    res = CliRunner().invoke(main, ["evaluate", str(out), "--data", str(csv), "-o", str(ev), "--json",
+                                    str(ev / "result.json"), "--closed-loop", "hanging", "--trial-s", "1.5"])
+    assert res.exit_code == 0, res.output
+    for name in ("open_loop.csv", "open_loop.md", "closed_loop.csv", "closed_loop.md", "predictions_left.png",
+                 "training_curves.png", "result.json"):
+        assert (ev / name).exists(), name
+    result = json.loads((ev / "result.json").read_text())
+    cands = {r["candidate"] for r in result["open_loop"]}
+    assert {"none", "pi", "feedforward"} <= cands and len(cands) == 5
+    assert all(r["split"] == "time_blocks" for r in result["open_loop"])
+    assert {r["setting"] for r in result["closed_loop"]} == {"hanging"}
+
+
+@pytest.mark.shared
+def test_real_recordings_train_and_beat_no_correction():
+    """On the thesis's recordings (cleaned by the data module), an MLP on the thesis task beats
+    sending the target unchanged on held-out time blocks."""
+    from seadesign.corrector.dataset import DatasetSpec, build_dataset
+    from seadesign.corrector.evaluate import open_loop_table
+    from seadesign.corrector.export import NumpyCorrector, numpy_arrays
+    from seadesign.corrector.recordings import load_recordings
+    from seadesign.corrector.runtime import NetCorrector, NoCorrection
+    from seadesign.corrector.splits import time_block_split
+    from seadesign.corrector.train import TrainConfig, fit
+
+    folder = shared_path("data", "deepsea")
+    files = [folder / f for f in ("free_dtest_part1.csv", "ground_dtest_part1.csv", "d1free.csv")]
+    recs = load_recordings(files)
+    assert [r.setting for r in recs] == ["hanging", "ground", "hanging"]
+    spec = DatasetSpec(task="thesis", modalities="velocity_effort", positive=True)
+    ds = build_dataset(recs, spec)
+    assert np.isfinite(ds.X).all() and len(ds) > 8000
+    sp = time_block_split(ds)
+    res = fit(ds, sp, 9.106, TrainConfig(model="mlp", max_epochs=40, patience=10, batch_size=1024))
+    net = NetCorrector(NumpyCorrector(numpy_arrays(res.net)), spec, "mlp")
+    table, _ = open_loop_table([NoCorrection(), net], recs, ds, sp.test, sp.name)
+    both = table[table.knee == "both"].set_index("candidate")
+    assert both.loc["mlp", "mae_rad"] < both.loc["none", "mae_rad"]
