@@ -23,7 +23,7 @@ import numpy as np
 from scipy.signal import lfilter
 
 from seadesign.effects import DahlHysteresis, DeadBand, GravityLoad, Param, TemperatureSoftening
-from seadesign.loop.table import LoopData
+from seadesign.loop.table import LoopData, smooth
 
 LOAD_STAGE = 7  # stages below act on the path term; from here on the whole prediction
 
@@ -119,7 +119,7 @@ def lowpass_uniform(x: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
 
 
 def _viscoelastic(data, th, path):
-    d = data.signals["displacement"]
+    d = data.smooth("displacement")
     return path + th[0] * (d - lowpass_uniform(d, data.time, th[1]))
 
 
@@ -164,8 +164,11 @@ def _drift(data, th, y):
 
 
 def _delay(data, th, y):
+    # shift the smoothed prediction and add the change, so that at td = 0 the prediction is unchanged
+    # and a fractional-sample shift cannot pose as a noise filter on the prediction
     t = data.time
-    return np.interp(t - th[0], t, y)
+    ys = smooth(y, t)
+    return y + np.interp(t - th[0], t, ys) - ys
 
 
 def _vel_scale(data) -> float:
