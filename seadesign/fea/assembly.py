@@ -22,12 +22,12 @@ _CHUNK = 2048  # elements per vectorised block (small blocks stay in cache)
 
 
 def _assemble(elements: np.ndarray, n_nodes: int, blocks: np.ndarray) -> sp.csr_matrix:
-    """Sum element blocks (m, nen, d, nen, d) into a CSR matrix with dofs ordered (node, component)."""
-    m, nen, d = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+    """Sum node-pair blocks (m, nen, nen, d, d) into a CSR matrix with dofs ordered (node, component)."""
+    m, nen, d = blocks.shape[0], blocks.shape[1], blocks.shape[3]
     rows = np.repeat(elements, nen, axis=1).ravel().astype(np.int64)
     cols = np.tile(elements, (1, nen)).ravel().astype(np.int64)
     keys, inv = np.unique(rows * n_nodes + cols, return_inverse=True)
-    data = blocks.transpose(0, 1, 3, 2, 4).reshape(m * nen * nen, d * d)
+    data = blocks.reshape(m * nen * nen, d * d)
     summed = np.stack([np.bincount(inv, weights=data[:, c], minlength=len(keys)) for c in range(d * d)], axis=1)
     brow, bcol = keys // n_nodes, keys % n_nodes
     indptr = np.searchsorted(brow, np.arange(n_nodes + 1))
@@ -39,11 +39,11 @@ def stiffness_matrix(mesh: ElementMesh, youngs_modulus_Pa: float, poisson_ratio:
     """Linear-elastic stiffness matrix (N/m) of an isotropic material, full symmetric CSR."""
     lam, mu = lame(youngs_modulus_Pa, poisson_ratio)
     nen = mesh.elements.shape[1]
-    blocks = np.empty((len(mesh.elements), nen, 3, nen, 3))
+    blocks = np.empty((len(mesh.elements), nen, nen, 3, 3))
     for start in range(0, len(mesh.elements), _CHUNK):
         el = mesh.elements[start : start + _CHUNK]
         grads, vol = barycentric_gradients(mesh.nodes_m, el)
-        blocks[start : start + len(el)] = stiffness_blocks(mesh.order, grads, vol, lam, mu).reshape(-1, nen, 3, nen, 3)
+        blocks[start : start + len(el)] = stiffness_blocks(mesh.order, grads, vol, lam, mu)
     return _assemble(mesh.elements, len(mesh.nodes_m), blocks)
 
 
@@ -52,5 +52,5 @@ def mass_matrix(mesh: ElementMesh) -> sp.csr_matrix:
     ref = mass_reference(mesh.order)
     _, vol = barycentric_gradients(mesh.nodes_m, mesh.elements)
     nen = mesh.elements.shape[1]
-    blocks = (vol[:, None, None] * ref[None]).reshape(-1, nen, 1, nen, 1)
+    blocks = (vol[:, None, None] * ref[None]).reshape(-1, nen, nen, 1, 1)
     return _assemble(mesh.elements, len(mesh.nodes_m), blocks)

@@ -103,7 +103,7 @@ def lame(youngs_modulus_Pa: float, poisson_ratio: float) -> tuple[float, float]:
 def stiffness_blocks(
     order: int, grads: np.ndarray, vol: np.ndarray, lam: float, mu: float
 ) -> np.ndarray:
-    """Element stiffness matrices (m, 3 nen, 3 nen) in N/m, dof order (node, component).
+    """Element stiffness matrices as node-pair blocks (m, nen, nen, 3, 3) in N/m.
 
     Exact for straight-sided elements: the degree-2(order-1) rule integrates the gradient
     products exactly.
@@ -115,14 +115,14 @@ def stiffness_blocks(
     # p[:, i, j, a, b] = sum_q w dN_a/dx_i dN_b/dx_j
     p = np.matmul(g[:, :, None], g[:, None].transpose(0, 1, 2, 4, 3))
     s = p[:, 0, 0] + p[:, 1, 1] + p[:, 2, 2]
-    k = np.empty((m, nen, 3, nen, 3))
+    k = np.empty((m, nen, nen, 3, 3))
     for i in range(3):
         for j in range(3):
             blk = lam * p[:, i, j] + mu * p[:, i, j].transpose(0, 2, 1)
             if i == j:
                 blk += mu * s
-            k[:, :, i, :, j] = blk * vol[:, None, None]
-    return k.reshape(m, 3 * nen, 3 * nen)
+            k[:, :, :, i, j] = blk * vol[:, None, None]
+    return k
 
 
 def mass_reference(order: int) -> np.ndarray:

@@ -2,10 +2,24 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import scipy.sparse as sp
 
 from seadesign.errors import SolverError
+
+
+def _pardiso_solver(mtype: int):
+    """A PyPardisoSolver; the MKL runtime path found by the first one is reused, because
+    pypardiso otherwise searches the whole environment tree (seconds) for every instance."""
+    import pypardiso
+
+    solver = pypardiso.PyPardisoSolver(mtype=mtype)
+    name = getattr(solver.libmkl, "_name", None)
+    if name and "PYPARDISO_MKL_RT" not in os.environ:
+        os.environ["PYPARDISO_MKL_RT"] = name
+    return solver
 
 
 class SPDFactorization:
@@ -17,11 +31,9 @@ class SPDFactorization:
         self.n = a.shape[0]
         self.backend = backend
         if backend == "pardiso":
-            import pypardiso
-
             self._upper = sp.triu(a, format="csr")
             self._upper.sort_indices()
-            self._solver = pypardiso.PyPardisoSolver(mtype=2)
+            self._solver = _pardiso_solver(mtype=2)
             try:
                 self._solver.factorize(self._upper)
             except Exception as exc:  # pardiso reports non-SPD and memory errors as exceptions
