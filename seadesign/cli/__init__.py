@@ -36,3 +36,4 @@ from seadesign.cli import design_cmds  # noqa: E402,F401
 from seadesign.cli import corrector_cmds  # noqa: E402,F401
 from seadesign.cli import data_cmds  # noqa: E402,F401
 from seadesign.cli import sweep_cmds  # noqa: E402,F401
+from seadesign.cli import loop_cmds  # noqa: E402,F401
