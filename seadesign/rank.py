@@ -93,7 +93,8 @@ def constraint_columns(t: pd.DataFrame, study: Study) -> pd.DataFrame:
         checks[f"k <= {rk.k_max_Nm_per_rad:g} Nm/rad"] = solved & (t["k_Nm_per_rad"] <= rk.k_max_Nm_per_rad)
     t = t.copy()
     t["allowable_stress_MPa"] = allowable_MPa
-    fails = pd.DataFrame({name: ~ok.fillna(False).astype(bool) for name, ok in checks.items()})
+    gate = {"valid geometry": pd.Series(True, index=t.index), "solved": t["status"] != "invalid"}
+    fails = pd.DataFrame({name: gate.get(name, solved) & ~ok.fillna(False).astype(bool) for name, ok in checks.items()})
     t["failed_constraints"] = ["; ".join(c for c in fails.columns if row[c]) for _, row in fails.iterrows()]
     t["n_failed_constraints"] = fails.sum(axis=1).astype(int)
     t["feasible"] = t["n_failed_constraints"] == 0

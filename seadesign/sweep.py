@@ -2,7 +2,8 @@
 
 Rows are written as they arrive, one JSON file per candidate under `<out>/rows/`, named by a
 hash of every input of that candidate (atomic write: temp file + rename). A rerun reuses rows
-whose inputs are unchanged, so an interrupted sweep resumes where it stopped; stages of the
+whose inputs are unchanged (failed ones are retried), so an interrupted sweep resumes where it
+stopped; stages of the
 others come from the content-addressed cache when their own inputs are unchanged.
 Invalid candidates keep their reasons; a candidate whose mesher or solver fails keeps the
 error and the sweep goes on.
@@ -78,7 +79,6 @@ def evaluate(job: Job, sink) -> dict:
             row.update(status="invalid", reason="; ".join(geo.reasons))
         else:
             unit = fea_response(job.study, p, checked, job.settings, job.cache, stage)
-            row.update(unit.mesh_quality)
             row.update(load_case_columns(unit, job.study))
     except Exception as exc:  # noqa: BLE001 - a failing candidate is a result, not a crash
         row.update(status="failed", reason=f"{type(exc).__name__}: {exc}".strip(),
@@ -125,7 +125,7 @@ def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverS
     rows: dict[int, dict] = {}
     for i, key in enumerate(keys):
         stored = read_row(rows_dir, key)
-        if stored is not None:
+        if stored is not None and stored["status"] != "failed":  # failures are retried
             rows[i] = stored
     reused = sorted(rows)
     todo = [Job(i, study, candidates[i], settings, cache, keys[i]) for i in range(len(candidates)) if i not in rows]
