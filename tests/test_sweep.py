@@ -1,0 +1,154 @@
+"""Sweep end to end on a tiny study: outputs, physics properties, resume, cache, failures."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from seadesign.cache import Cache
+from seadesign.cli import main
+from seadesign.errors import MeshError, SpringFileError
+from seadesign.handoff import load_spring, validate_spring
+from seadesign.study import load_study
+from seadesign.sweep import run_sweep
+from sweep_helpers import write_tiny_study
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """(study path, cache dir, output root) after one CLI sweep of the tiny study."""
+    root = tmp_path_factory.mktemp("sweep")
+    study = write_tiny_study(root)
+    cache_dir = root / "cache"
+    out = root / "exports"
+    result = CliRunner().invoke(main, ["sweep", str(study), "--jobs", "1", "--quiet", "--out", str(out),
+                                       "--cache-dir", str(cache_dir)])
+    assert result.exit_code == 0, result.output
+    return study, cache_dir, out
+
+
+def test_outputs_exist_and_choice_is_the_valid_candidate(tiny):
+    _, _, out = tiny
+    folder = out / "tiny"
+    for name in ("results.parquet", "results.csv", "settings.json", "report.html", "report.md", "spring.json",
+                 "reaction_displacement.png", "k_vs_beams.png", "pareto.png", "3beams_8mm.stl", "3beams_8mm.step"):
+        assert (folder / name).is_file(), name
+    t = pd.read_csv(folder / "results.csv")
+    assert len(t) == 2
+    invalid = t[t["beam_count"] == 10].iloc[0]
+    assert invalid["status"] == "invalid" and "touch" in invalid["reason"]
+    spring = load_spring(folder / "spring.json")  # validates against the schema
+    assert spring["design"]["beam_count"] == 3 and spring["k_source"] == "fea"
+    html = (folder / "report.html").read_text()
+    assert "<img" in html and "src='data:image/png;base64," in html and ".png'" not in html
+    settings = json.loads((folder / "settings.json").read_text())
+    assert "numpy" in settings["versions"]
+
+
+def test_results_obey_the_physics(tiny):
+    study_path, _, out = tiny
+    s = load_study(study_path)
+    r = pd.read_parquet(out / "tiny" / "results.parquet")
+    r = r[r["status"] == "ok"].iloc[0]
+    k = r["k_Nm_per_rad"]
+    assert r["stall_rotation_rad"] == pytest.approx(s.load_cases.stall_torque_Nm / k, rel=1e-9)
+    # rigid hub: the bearing circle moves by rotation x radius (plus a small translation)
+    assert r["stall_bearing_displacement_mm"] == pytest.approx(r["stall_rotation_rad"] * s.bearing_radius_mm, rel=0.05)
+    tau = s.robot.mass_kg * 9.80665 / 2 * s.robot.lower_leg_m * math.sin(math.radians(15.0))
+    assert r["standing_deflection_deg"] == pytest.approx(math.degrees(tau / k), rel=1e-9)
+    assert r["impact_energy_J"] == pytest.approx(27.6957 ** 2 / (2 * k), rel=1e-4)
+    omega = s.ranking.impact_speed_m_per_s / s.robot.lower_leg_m
+    assert r["impact_gearbox_torque_Nm"] == pytest.approx(omega * math.sqrt(k * s.ranking.knee_inertia_kg_m2))
+    # stresses scale with torque: impact / stall von Mises = torque ratio
+    assert r["impact_von_mises_max_MPa"] / r["stall_von_mises_max_MPa"] == pytest.approx(27.6957 / 11.7, rel=1e-4)
+    assert bool(r["extrapolation"]) == (max(r["stall_rotation_rad"], r["impact_rotation_rad"]) > 0.1)
+    spring = load_spring(out / "tiny" / "spring.json")
+    assert spring["extrapolation"]["flagged"] == bool(r["extrapolation"])
+    assert spring["k_Nm_per_rad"] == pytest.approx(k)
+
+
+def test_resume_after_interrupt(tiny, tmp_path):
+    study_path, cache_dir, _ = tiny
+    s = load_study(study_path)
+
+    def stop(row):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(s, tmp_path, cache=Cache(cache_dir), jobs=1, quiet=True, on_row=stop)
+    assert len(list((tmp_path / "rows").glob("*.json"))) == 1  # the finished row survived
+    again = run_sweep(s, tmp_path, cache=Cache(cache_dir), jobs=1, quiet=True)
+    assert len(again.reused) == 1 and len(again.computed) == 1
+    assert sorted(again.reused + again.computed) == [0, 1]
+
+
+def test_cache_hit_and_load_change_reuses_the_solve(tiny, tmp_path):
+    study_path, cache_dir, _ = tiny
+    s = load_study(study_path)
+    fea_entries = set((cache_dir / "fea").rglob("*.pkl"))
+    warm = run_sweep(s, tmp_path / "a", cache=Cache(cache_dir), jobs=1, quiet=True)
+    assert warm.rows.loc[0, "elapsed_s"] < 5.0  # no mesh, no solve
+    heavier = write_tiny_study(tmp_path, stall_torque_Nm="23.4")
+    h = run_sweep(load_study(heavier), tmp_path / "b", cache=Cache(cache_dir), jobs=1, quiet=True)
+    assert set((cache_dir / "fea").rglob("*.pkl")) == fea_entries  # load change: no new solve
+    assert h.rows.loc[0, "row_key"] != warm.rows.loc[0, "row_key"]
+    assert h.rows.loc[0, "stall_rotation_rad"] == pytest.approx(2 * warm.rows.loc[0, "stall_rotation_rad"])
+    assert h.rows.loc[0, "k_Nm_per_rad"] == warm.rows.loc[0, "k_Nm_per_rad"]
+
+
+@pytest.mark.slow
+def test_modulus_change_resolves_on_the_cached_mesh(tiny, tmp_path):
+    import dataclasses
+
+    study_path, cache_dir, _ = tiny
+    s = load_study(study_path)
+    base = run_sweep(s, tmp_path / "a", cache=Cache(cache_dir), jobs=1, quiet=True)
+    meshes = set((cache_dir / "mesh").rglob("*"))
+    stiff = dataclasses.replace(s, material=s.material.scaled(2.0, "test"))
+    r = run_sweep(stiff, tmp_path / "b", cache=Cache(cache_dir), jobs=1, quiet=True)
+    assert set((cache_dir / "mesh").rglob("*")) == meshes
+    # linear elasticity at fixed Poisson ratio: k proportional to E
+    assert r.rows.loc[0, "k_Nm_per_rad"] == pytest.approx(2 * base.rows.loc[0, "k_Nm_per_rad"], rel=1e-6)
+
+
+def test_failing_candidate_is_recorded_and_the_sweep_goes_on(tmp_path, monkeypatch):
+    import seadesign.stages as stages
+
+    def broken(study, params, checked, cache):
+        raise MeshError("mesher gave up (test)")
+
+    monkeypatch.setattr(stages, "tetrahedralize", broken)
+    study = load_study(write_tiny_study(tmp_path, beam_count="[3, 10]"))
+    run = run_sweep(study, tmp_path / "out", cache=Cache(tmp_path / "c", enabled=False), jobs=1, quiet=True)
+    rows = run.rows.set_index("beam_count")
+    assert rows.loc[3, "status"] == "failed" and "mesher gave up" in rows.loc[3, "reason"]
+    assert rows.loc[10, "status"] == "invalid"
+
+
+def test_spring_schema_refuses_a_document_without_k(tiny):
+    _, _, out = tiny
+    doc = json.loads((out / "tiny" / "spring.json").read_text())
+    validate_spring(doc)
+    del doc["k_Nm_per_rad"]
+    with pytest.raises(SpringFileError, match="k_Nm_per_rad"):
+        validate_spring(doc)
+
+
+def test_calibration_scales_the_modulus(tmp_path):
+    from seadesign.cli.sweep_cmds import apply_calibration
+    from seadesign.errors import ConfigError
+
+    s = load_study(write_tiny_study(tmp_path))
+    (tmp_path / "c.json").write_text(json.dumps({"youngs_modulus_Pa": 6e6}))
+    c, _ = apply_calibration(s, tmp_path / "c.json")
+    assert c.material.youngs_modulus_Pa == pytest.approx(6e6)
+    (tmp_path / "bad.json").write_text(json.dumps({"stiffness_scale": -1}))
+    with pytest.raises(ConfigError, match="stiffness_scale"):
+        apply_calibration(s, tmp_path / "bad.json")
+    assert np.isfinite(s.material.youngs_modulus_Pa)
