@@ -58,8 +58,9 @@ def test_results_obey_the_physics(tiny):
     r = r[r["status"] == "ok"].iloc[0]
     k = r["k_Nm_per_rad"]
     assert r["stall_rotation_rad"] == pytest.approx(s.load_cases.stall_torque_Nm / k, rel=1e-9)
-    # rigid hub: the bearing circle moves by rotation x radius (plus a small translation)
-    assert r["stall_bearing_displacement_mm"] == pytest.approx(r["stall_rotation_rad"] * s.bearing_radius_mm, rel=0.05)
+    # rigid hub: the bearing circle moves by at least rotation x radius; the hub's small translation adds
+    arc_mm = r["stall_rotation_rad"] * s.bearing_radius_mm
+    assert arc_mm * (1 - 1e-9) <= r["stall_bearing_displacement_mm"] <= 1.15 * arc_mm
     tau = s.robot.mass_kg * 9.80665 / 2 * s.robot.lower_leg_m * math.sin(math.radians(15.0))
     assert r["standing_deflection_deg"] == pytest.approx(math.degrees(tau / k), rel=1e-9)
     assert r["impact_energy_J"] == pytest.approx(27.6957 ** 2 / (2 * k), rel=1e-4)
