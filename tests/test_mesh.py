@@ -2,29 +2,14 @@
 
 from __future__ import annotations
 
-import cadquery as cq
 import numpy as np
 import pytest
+from helpers_parts import holed_annulus
 
 from seadesign.errors import MeshError
 from seadesign.mesh import mesh_part
 from seadesign.mesh.tetmesh import boundary_facets
-from seadesign.part import Hole, Interfaces
-
-R_HUB_HOLES, R_RING_HOLES = 6.0, 17.0
-
-
-def holed_annulus() -> tuple[cq.Solid, Interfaces]:
-    """Flat annulus (bore 3, outer 20, 5 thick, mm) with 4 hub holes and 6 ring holes."""
-    hub = tuple(Hole(R_HUB_HOLES * np.cos(a), R_HUB_HOLES * np.sin(a), 1.2) for a in np.arange(4) * np.pi / 2)
-    ring = tuple(Hole(R_RING_HOLES * np.cos(a), R_RING_HOLES * np.sin(a), 1.5) for a in np.arange(6) * np.pi / 3)
-    wp = cq.Workplane("XY").circle(20.0).circle(3.0).extrude(5.0)
-    for h in hub + ring:
-        wp = wp.cut(cq.Workplane("XY").center(h.x_mm, h.y_mm).circle(h.radius_mm).extrude(5.0))
-    ifc = Interfaces(hub, ring, bore_radius_mm=3.0, hub_radius_mm=9.0, ring_inner_radius_mm=14.0,
-                     ring_outer_radius_mm=20.0, thickness_mm=5.0)
-    return wp.val(), ifc
-
+from seadesign.part import Interfaces
 
 @pytest.fixture(scope="module")
 def part():

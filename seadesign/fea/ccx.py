@@ -19,6 +19,7 @@ import numpy as np
 
 from seadesign.errors import SolverError
 from seadesign.fea.elements import ElementMesh
+from seadesign.fea.torsion import UnitTorsion
 
 
 def _block(ids: np.ndarray, per_line: int = 16) -> str:
@@ -35,55 +36,61 @@ def write_inp(
     youngs_modulus_Pa: float,
     poisson_ratio: float,
     torque_Nm: float,
+    loaded: str = "hub",
 ) -> Path:
-    """Write a CalculiX deck for torque_Nm about +z on the rigid hub with the ring held.
+    """Write a CalculiX deck: torque_Nm about +z on the rigidly coupled `loaded` side ("hub":
+    stall case, "ring": impact case), the other side's surface held.
 
     Node and element numbers are ours + 1; the two extra nodes N+1 (reference) and N+2 (rotation)
     carry the rigid body's translation and rotation (its dofs 1-3 are rotations about x, y, z).
     """
     if emesh.order != 2:
         raise SolverError("the CalculiX export writes C3D10 elements; build the mesh with order 2")
+    if loaded not in ("hub", "ring"):
+        raise SolverError(f"loaded side must be 'hub' or 'ring', got {loaded!r}")
+    coupled, held = ("HUB", "RING") if loaded == "hub" else ("RING", "HUB")
     n = len(emesh.nodes_m)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     nodes = np.column_stack([np.arange(1, n + 1), emesh.nodes_m])
     elems = np.column_stack([np.arange(1, len(emesh.elements) + 1), emesh.elements + 1])
+    ref = ", ".join(f"{c:.12e}" for c in ref_m)
     with open(path, "w") as f:
-        f.write("*HEADING\nseadesign torsion: hub rigid (moment about +z), ring held; units m, N, Pa\n")
+        f.write(f"*HEADING\nseadesign torsion: {coupled} rigid with a moment about +z, {held} held; units m, N, Pa\n")
         f.write("*NODE, NSET=NALL\n")
         np.savetxt(f, nodes, fmt=["%d", "%.12e", "%.12e", "%.12e"], delimiter=", ")
-        f.write(f"*NODE, NSET=REFNODES\n{n + 1}, {ref_m[0]:.12e}, {ref_m[1]:.12e}, {ref_m[2]:.12e}\n")
-        f.write(f"{n + 2}, {ref_m[0]:.12e}, {ref_m[1]:.12e}, {ref_m[2]:.12e}\n")
+        f.write(f"*NODE, NSET=REFNODES\n{n + 1}, {ref}\n{n + 2}, {ref}\n")
         f.write("*ELEMENT, TYPE=C3D10, ELSET=EALL\n")
         np.savetxt(f, elems, fmt="%d", delimiter=", ")
         f.write(f"*NSET, NSET=HUB\n{_block(hub_nodes)}\n")
         f.write(f"*NSET, NSET=RING\n{_block(ring_nodes)}\n")
         f.write(f"*MATERIAL, NAME=SPRING\n*ELASTIC\n{youngs_modulus_Pa:.12e}, {poisson_ratio:.12e}\n")
         f.write("*SOLID SECTION, ELSET=EALL, MATERIAL=SPRING\n")
-        f.write(f"*RIGID BODY, NSET=HUB, REF NODE={n + 1}, ROT NODE={n + 2}\n")
-        f.write("*BOUNDARY\nRING, 1, 3\n")
+        f.write(f"*RIGID BODY, NSET={coupled}, REF NODE={n + 1}, ROT NODE={n + 2}\n")
+        f.write(f"*BOUNDARY\n{held}, 1, 3\n")
         f.write("*STEP\n*STATIC\n")
         f.write(f"*CLOAD\n{n + 2}, 3, {torque_Nm:.12e}\n")
         f.write("*NODE PRINT, NSET=NALL\nU\n")
         f.write("*NODE PRINT, NSET=REFNODES\nU\n")
-        f.write("*NODE PRINT, NSET=RING, TOTALS=ONLY\nRF\n")
+        f.write(f"*NODE PRINT, NSET={held}\nRF\n")
         f.write("*END STEP\n")
     return path
 
 
 @dataclass(frozen=True)
 class CcxResult:
-    """CalculiX results: displacements (N, 3) in m, hub rotation about z (rad), total ring
-    reaction force (N), wall time (s) of the ccx run."""
+    """CalculiX results: displacements (N, 3) in m, rotation of the loaded side about z (rad),
+    reaction forces (N) on the held nodes (0-based ids), wall time (s) of the ccx run."""
 
     displacement_m: np.ndarray
-    hub_rotation_rad: float
-    ring_reaction_force_N: np.ndarray
+    rotation_rad: float
+    held_nodes: np.ndarray
+    reaction_N: np.ndarray
     wall_s: float
 
 
 def _dat_blocks(text: str) -> dict[str, list[list[float]]]:
-    """Numeric rows after each ' displacements'/' forces' header of a .dat file, keyed by header."""
+    """Numeric rows after each text header of a .dat file, keyed by the header."""
     blocks: dict[str, list[list[float]]] = {}
     current = None
     for line in text.splitlines():
@@ -120,17 +127,36 @@ def run_ccx(inp: Path, n_nodes: int, timeout_s: float = 600.0, threads: int | No
         tail = "\n".join((proc.stdout + proc.stderr).splitlines()[-15:])
         raise SolverError(f"ccx failed (exit {proc.returncode}):\n{tail}")
     blocks = _dat_blocks(dat.read_text())
-    disp = next(v for k, v in blocks.items() if k.startswith("displacements") and "NALL" in k)
-    ref = next(v for k, v in blocks.items() if k.startswith("displacements") and "REFNODES" in k)
-    rf = next(v for k, v in blocks.items() if k.startswith("total force") and "RING" in k)
-    arr = np.array(disp)
+    disp = np.array(next(v for k, v in blocks.items() if k.startswith("displacements") and "NALL" in k))
+    ref = {int(r[0]): r[1:4] for r in next(v for k, v in blocks.items() if k.startswith("displacements") and "REFNODES" in k)}
+    rf = np.array(next(v for k, v in blocks.items() if k.startswith("forces")))
     u = np.zeros((n_nodes, 3))
-    u[arr[:, 0].astype(int) - 1] = arr[:, 1:4]
-    rot = {int(r[0]): r[1:4] for r in ref}
-    rot_node = n_nodes + 2
+    u[disp[:, 0].astype(int) - 1] = disp[:, 1:4]
     return CcxResult(
         displacement_m=u,
-        hub_rotation_rad=float(rot[rot_node][2]),
-        ring_reaction_force_N=np.array(rf[0]),
+        rotation_rad=float(ref[n_nodes + 2][2]),
+        held_nodes=rf[:, 0].astype(int) - 1,
+        reaction_N=rf[:, 1:4],
         wall_s=wall,
     )
+
+
+def write_load_case_decks(
+    directory: Path,
+    unit: UnitTorsion,
+    youngs_modulus_Pa: float,
+    poisson_ratio: float,
+    stall_torque_Nm: float,
+    impact_torque_Nm: float,
+) -> dict[str, Path]:
+    """stall.inp (torque on the hub, ring held) and impact.inp (torque on the ring, hub held)
+    for the mesh and couplings of a solve, so anyone can rerun them with `ccx -i stall`."""
+    hub = np.unique(np.concatenate(list(unit.hub_groups.values())))
+    directory = Path(directory)
+    return {
+        case: write_inp(
+            directory / f"{case}.inp", unit.emesh, hub, unit.ring_nodes, unit.ref_m,
+            youngs_modulus_Pa, poisson_ratio, torque, loaded=side,
+        )
+        for case, torque, side in (("stall", stall_torque_Nm, "hub"), ("impact", impact_torque_Nm, "ring"))
+    }

@@ -120,9 +120,9 @@ def mesh_part(
     if hit is not None:
         points, tets = hit
     else:
-        for _ in range(retries + 1):
+        for attempt in range(retries + 1):
             try:
-                points, tets = _run_worker(settings, inputs, timeout_s)
+                points, tets = _run_worker({**settings, "attempt": attempt}, inputs, timeout_s)
             except (TimeoutError, RuntimeError) as exc:
                 attempts.append(str(exc))
                 continue

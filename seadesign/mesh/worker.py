@@ -22,8 +22,12 @@ def tetwild(vertices: np.ndarray, faces: np.ndarray, edge_length_fac: float, eps
     )
 
 
-def gmsh_brep(brep: Path, size_mm: float) -> tuple[np.ndarray, np.ndarray]:
-    """gmsh Delaunay on the exact CAD geometry, single-threaded (deterministic); size in mm."""
+GMSH_ALGORITHMS = (1, 4, 10)  # Delaunay, then Frontal, then HXT for retries
+
+
+def gmsh_brep(brep: Path, size_mm: float, attempt: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """gmsh on the exact CAD geometry, single-threaded (deterministic); size in mm. Retries
+    switch the 3D algorithm, since repeating a deterministic failure cannot help."""
     import gmsh
 
     gmsh.initialize(interruptible=False)
@@ -34,7 +38,7 @@ def gmsh_brep(brep: Path, size_mm: float) -> tuple[np.ndarray, np.ndarray]:
         gmsh.model.occ.synchronize()
         gmsh.option.setNumber("Mesh.MeshSizeMax", size_mm)
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.1 * size_mm)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+        gmsh.option.setNumber("Mesh.Algorithm3D", GMSH_ALGORITHMS[attempt % len(GMSH_ALGORITHMS)])
         gmsh.option.setNumber("Mesh.Optimize", 1)
         gmsh.model.mesh.generate(3)
         tags, coords, _ = gmsh.model.mesh.getNodes()
@@ -56,7 +60,7 @@ def main(job_dir: str) -> None:
         s = np.load(job_dir / "surface.npz")
         points, tets = tetwild(s["vertices"], s["faces"], job["edge_length_fac"], job["epsilon"])
     else:
-        points, tets = gmsh_brep(job_dir / "part.brep", job["size_mm"])
+        points, tets = gmsh_brep(job_dir / "part.brep", job["size_mm"], job["attempt"])
     np.savez(job_dir / "tets.npz", points=points, tets=tets)
 
 
