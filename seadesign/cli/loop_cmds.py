@@ -52,7 +52,8 @@ def _kind(path: Path) -> str:
 @click.option("--knee", type=click.Choice(["l", "r"]), default="l", show_default=True,
               help="Robot recordings: which knee (l left, r right; the right is un-mirrored).")
 @click.option("--keep-lifted/--drop-lifted", default=True, show_default=True,
-              help="Robot recordings: keep rows whose foot pressure sum is low (robot hanging).")
+              help="Robot recordings: keep rows whose foot pressure sum is low (robot hanging). Recordings are "
+                   "cleaned first (artefact rows dropped, wrap-arounds unwrapped, Hall offsets removed).")
 @click.option("--measured", default=None, help="Generic table: column of the measured quantity (any unit).")
 @click.option("--predicted", default=None, help="Generic table: column of the model's prediction (unit of --measured).")
 @click.option("--signal", "signals", multiple=True,
@@ -86,9 +87,7 @@ def explain_cmd(file: Path, spring_path: Path | None, json_out: Path | None, out
             data = bench_loop_data(read_bench(file), spring, predict)
             declared, loop_plot, stem = tuple(declare), True, file.stem
         else:
-            table = read_recording(file)
-            if not keep_lifted:
-                table = clean(table, normalise=False, euler=False).table
+            table = clean(read_recording(file), keep_lifted=keep_lifted, normalise=False, euler=False).table
             data = robot_loop_data(table, spring, knee)
             declared, loop_plot, stem = tuple(declare) or ROBOT_DECLARED, False, f"{file.stem}_{knee}"
     ex = explain(data, declared, min_gain=min_gain)

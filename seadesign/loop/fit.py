@@ -69,10 +69,13 @@ class Fit:
     extra: dict = field(default_factory=dict)
 
     def parameters(self) -> dict[str, dict[str, dict[str, float | str]]]:
-        """effect -> parameter -> {value, uncertainty, unit, meaning}."""
+        """effect -> parameter -> {value, uncertainty, unit, meaning, at_bound} (at_bound: the fit hit a
+        search bound, so the value is a limit, not an estimate)."""
         out: dict = {}
         for (key, p), v, s in zip(self.params, self.theta, self.sigma):
-            out.setdefault(key, {})[p.name] = {"value": float(v), "uncertainty": float(s), "unit": p.unit, "meaning": p.doc}
+            at_bound = bool(np.isclose(v, p.lower, rtol=1e-6, atol=0) or np.isclose(v, p.upper, rtol=1e-6, atol=0))
+            out.setdefault(key, {})[p.name] = {"value": float(v), "uncertainty": float(s), "unit": p.unit,
+                                               "meaning": p.doc, "at_bound": at_bound}
         return out
 
 

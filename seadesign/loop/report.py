@@ -126,7 +126,8 @@ def markdown(report: dict[str, Any], images: list[Path]) -> str:
                   "|---|---|---|---|---|"]
         for eff, ps in s["parameters"].items():
             for name, p in ps.items():
-                lines.append(f"| {eff} | {name} | {_fmt(p['value'])} | {_fmt(p['uncertainty'])} | {p['unit']} |")
+                bound = " (at search bound)" if p["at_bound"] else ""
+                lines.append(f"| {eff} | {name} | {_fmt(p['value'])}{bound} | {_fmt(p['uncertainty'])} | {p['unit']} |")
         lines += ["", f"Candidates tried (held-out RMSE {u}, BIC):", "", "| candidate | held-out RMSE | BIC | accepted |",
                   "|---|---|---|---|"]
         lines += [f"| {t['effect']} | {_fmt(t['held_out_rmse'])} | {t['bic']:.1f} | {'yes' if t['accepted'] else 'no'} |"
