@@ -2,10 +2,14 @@
 
 All parameters of all effects in the model are fitted together on the training samples
 (`scipy.optimize.least_squares`, trust-region reflective with bounds; positive scale
-parameters such as time constants are searched in log space). Uncertainty is the
+parameters such as time constants are searched in log space). The model is always evaluated
+over the whole record (stateful effects need the history), but the optimiser sees at most
+`MAX_FIT_ROWS` evenly spaced training samples, which keeps its linear algebra small on long
+recordings; errors and information criteria use every training sample, and the Jacobian is
+rescaled to the full count for the uncertainties. Uncertainty is the
 standard error from the Jacobian, cov = s^2 (J^T J)^-1 with s^2 = SSR / (n - p); residuals of
 real recordings are correlated, so these are lower bounds. Information criteria use the
-Gaussian likelihood: AIC = n ln(SSR/n) + 2p, BIC = n ln(SSR/n) + p ln n.
+Gaussian likelihood on all training samples: AIC = n ln(SSR/n) + 2p, BIC = n ln(SSR/n) + p ln n.
 """
 
 from __future__ import annotations
@@ -21,6 +25,8 @@ from seadesign.effects import Param
 from seadesign.loop.candidates import LIBRARY, LOAD_STAGE, Candidate
 from seadesign.loop.metrics import split_metrics
 from seadesign.loop.table import LoopData
+
+MAX_FIT_ROWS = 8000
 
 
 def order(keys: Sequence[str]) -> list[Candidate]:
@@ -113,10 +119,12 @@ def fit(data: LoopData, keys: Sequence[str], held: np.ndarray,
                    int(train.sum()))
     warm = warm or {}
     options = [[list(warm[k])] if k in warm else LIBRARY[k].starts(data) for k in keys]
-    y = data.measured[train]
+    n = int(train.sum())
+    rows = np.flatnonzero(train)[:: max(1, -(-n // MAX_FIT_ROWS))]
+    y = data.measured[rows]
 
     def resid(u):
-        return predict(data, keys, np.clip(to_x(u), lo, hi))[train] - y
+        return predict(data, keys, np.clip(to_x(u), lo, hi))[rows] - y
 
     best = None
     for combo in product(*options):
@@ -125,16 +133,16 @@ def fit(data: LoopData, keys: Sequence[str], held: np.ndarray,
         res = least_squares(resid, u0, bounds=(ulo, uhi), x_scale="jac", method="trf", max_nfev=100 * len(u0))
         if best is None or res.cost < best.cost:
             best = res
-    n, p = int(train.sum()), len(params)
-    ssr = 2.0 * float(best.cost)
+    p = len(params)
     x = np.clip(to_x(best.x), lo, hi)
+    pred = predict(data, keys, x)
+    ssr = float(np.sum((data.measured[train] - pred[train]) ** 2))
     jac = best.jac * np.where(logs, 1.0 / x, 1.0)  # chain rule: d/dx = d/du / x for log parameters
     try:
-        cov = np.linalg.pinv(jac.T @ jac) * ssr / max(n - p, 1)
+        cov = np.linalg.pinv(jac.T @ jac * (n / rows.size)) * ssr / max(n - p, 1)
         sigma = np.sqrt(np.clip(np.diag(cov), 0, None))
     except np.linalg.LinAlgError:
         sigma = np.full(p, np.nan)
-    pred = predict(data, keys, x)
     aic, bic = _scores(ssr, n, p)
     return Fit(keys, x, sigma, params, pred, split_metrics(data.measured, pred, held), aic, bic, n)
 
