@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from seadesign.errors import ConfigError
-from seadesign.geometry import GeometryParams, Part, build_part
+from seadesign.geometry import Part, build_part
+from seadesign.params import GeometryParams
 from seadesign.study import Study
 from seadesign.validity import check
 

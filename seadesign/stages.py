@@ -20,7 +20,7 @@ from typing import Callable
 import numpy as np
 
 from seadesign.cache import Cache, digest, package_versions
-from seadesign.geometry import GeometryParams
+from seadesign.params import GeometryParams
 from seadesign.study import Study
 
 Progress = Callable[[str], None]  # receives the name of the stage that starts

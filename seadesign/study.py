@@ -12,10 +12,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from seadesign.errors import ConfigError
-from seadesign.geometry import BoltPattern, GeometryParams, NutSlots
 from seadesign.materials import Material, load_material
+from seadesign.params import BoltPattern, GeometryParams, NutSlots, ValidityRules
 from seadesign.tomlcheck import Table, read_toml
-from seadesign.validity import ValidityRules
 
 STUDIES_DIR = Path(__file__).resolve().parents[1] / "studies"
 DEFAULT_STUDY = STUDIES_DIR / "wolfgang_knee.toml"

@@ -22,7 +22,7 @@ import pandas as pd
 
 from seadesign.cache import Cache, digest, package_versions
 from seadesign.executors import default_jobs, execute
-from seadesign.geometry import GeometryParams
+from seadesign.params import GeometryParams
 from seadesign.progress import ProgressDisplay
 from seadesign.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key, load_case_columns
 from seadesign.study import Study

@@ -8,22 +8,13 @@ wall to the gaps and to the outer edges. Each failed check gives a precise reaso
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import cadquery as cq
 import numpy as np
 from shapely.geometry import Point, Polygon
 
 from seadesign.geometry import Part
-
-
-@dataclass(frozen=True)
-class ValidityRules:
-    """Printability limits (mm)."""
-
-    min_clearance_mm: float  # gap between neighbouring beams
-    min_feature_mm: float  # shortest edge / narrowest slit the printer resolves
-    min_wall_mm: float  # material between a bolt hole and a gap or outer edge
+from seadesign.params import ValidityRules
 
 
 def _wire_polygon(wire: cq.Wire, step_mm: float = 0.05) -> np.ndarray:

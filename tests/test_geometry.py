@@ -10,7 +10,8 @@ import trimesh
 
 from seadesign.candidates import check_candidate
 from seadesign.export import write_step, write_stl
-from seadesign.geometry import BoltPattern, GeometryParams, build_part
+from seadesign.geometry import build_part
+from seadesign.params import BoltPattern, GeometryParams
 from seadesign.study import load_study
 from seadesign.validity import check
 
