@@ -1,0 +1,109 @@
+"""`seadesign solve`: FEA of one study candidate or of a given STL, with exports."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from seadesign.cli import main
+from seadesign.errors import ConfigError
+
+SUMMARY = (
+    ("k_Nm_per_rad", "spring constant k", "Nm/rad"),
+    ("stall_rotation_rad", "stall: hub rotation", "rad"),
+    ("stall_bearing_displacement_mm", "stall: max displacement on the bearing circle", "mm"),
+    ("stall_von_mises_max_MPa", "stall: peak von Mises", "MPa"),
+    ("stall_principal_1_max_MPa", "stall: peak 1st principal", "MPa"),
+    ("stall_principal_3_min_MPa", "stall: peak 3rd principal", "MPa"),
+    ("stall_max_shear_max_MPa", "stall: peak max shear", "MPa"),
+    ("impact_reaction_per_bolt_N", "impact: reaction per hub bolt (largest)", "N"),
+    ("impact_peak_nodal_reaction_N", "impact: peak nodal reaction (mesh dependent)", "N"),
+    ("impact_von_mises_max_MPa", "impact: peak von Mises", "MPa"),
+    ("impact_principal_1_max_MPa", "impact: peak 1st principal", "MPa"),
+    ("impact_principal_3_min_MPa", "impact: peak 3rd principal", "MPa"),
+    ("impact_max_shear_max_MPa", "impact: peak max shear", "MPa"),
+    ("safety_factor", "safety factor vs yield (both cases)", "-"),
+    ("equilibrium_rel_error", "equilibrium: |reaction + applied| / applied torque", "-"),
+    ("mesh_tets", "tetrahedra", "-"),
+    ("dofs", "degrees of freedom (P2)", "-"),
+    ("time_total_s", "wall time", "s"),
+)
+
+
+@main.command()
+@click.argument("study", required=False)
+@click.option("--beams", type=int, help="Beam count of the study candidate.")
+@click.option("--thickness-mm", type=float, help="Beam thickness (in-plane width, mm) of the study candidate.")
+@click.option("--stl", "stl", type=click.Path(dir_okay=False, path_type=Path), help="Solve this STL (mm) instead.")
+@click.option("--axis", type=click.Choice(["x", "y", "z"]), default="y", show_default=True, help="STL spring axis.")
+@click.option("--beam-width-mm", type=float, help="STL: beam width that sets the mesh size.")
+@click.option("--material", help="Material name (materials/NAME.toml); default: the study's, ninjaflex for --stl.")
+@click.option("--material-E-Pa", "youngs", type=float, help="Override Young's modulus (Pa).")
+@click.option("--material-nu", "nu", type=float, help="Override Poisson ratio.")
+@click.option("--material-yield-Pa", "yield_", type=float, help="Override yield strength (Pa).")
+@click.option("--stall-torque-Nm", type=float, help="Default: the study's (for --stl: the default study's).")
+@click.option("--impact-torque-Nm", type=float, help="Default: the study's (for --stl: the default study's).")
+@click.option("--bearing-radius-mm", type=float, help="Default: the study's; for --stl the detected hub radius.")
+@click.option("--elements-across-beam", type=float, help="Mesh density; default: the study's (3 for --stl).")
+@click.option("--backend", type=click.Choice(["gmsh", "pytetwild"]), help="Mesher; default: the study's (STL: pytetwild).")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+              help="Where to write NAME.json and NAME.vtu; default exports/<study or STL name>/.")
+@click.option("--export-ccx", "ccx_dir", type=click.Path(file_okay=False, path_type=Path),
+              help="Also write CalculiX decks stall.inp and impact.inp here.")
+def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs, nu, yield_, stall_torque_nm,
+          impact_torque_nm, bearing_radius_mm, elements_across_beam, backend, out_dir, ccx_dir) -> None:
+    """Mesh and solve the stall and impact load cases of one part; print and write the results.
+
+    Either STUDY --beams N --thickness-mm T (a candidate of a study), or --stl FILE --beam-width-mm W.
+    """
+    from seadesign.fea.solve_part import solve_part
+    from seadesign.materials import load_material
+    from seadesign.study import load_study
+
+    if (stl is None) == (study is None):
+        raise ConfigError("give either a STUDY (with --beams and --thickness-mm) or --stl FILE, not both or neither")
+    st = load_study(study) if study is not None else load_study()
+    if stl is not None:
+        from seadesign.mesh import load_stl
+        from seadesign.mesh.detect import detect_interfaces
+
+        if beam_width_mm is None:
+            raise ConfigError("--stl needs --beam-width-mm (the beams' in-plane width sets the mesh size)")
+        geometry = load_stl(stl, axis)
+        interfaces = detect_interfaces(*geometry)
+        mat = load_material(material or "ninjaflex")
+        name, width = stl.stem, beam_width_mm
+        bearing = bearing_radius_mm or interfaces.hub_radius_mm
+        across, mesher = elements_across_beam or 3.0, backend or "pytetwild"
+    else:
+        if beams is None or thickness_mm is None:
+            raise ConfigError("the study form needs --beams N and --thickness-mm T")
+        from seadesign.candidates import check_candidate, find_candidate
+
+        checked = check_candidate(st, find_candidate(st, beams, thickness_mm))
+        if not checked.valid:
+            raise ConfigError(f"candidate {beams} beams / {thickness_mm:g} mm is invalid: {'; '.join(checked.reasons)}")
+        geometry, interfaces = checked.part.solid, checked.part.interfaces
+        mat = load_material(material) if material else st.material
+        name, width = f"{beams}_beams_{thickness_mm:g}mm", thickness_mm
+        bearing = bearing_radius_mm or st.bearing_radius_mm
+        across = elements_across_beam or st.mesh.elements_across_beam
+        mesher = backend or st.mesh.backend
+    out_dir = out_dir or Path("exports") / (st.name if stl is None else stl.stem)
+    results, _, _ = solve_part(
+        geometry, interfaces,
+        youngs_modulus_Pa=youngs or mat.youngs_modulus_Pa,
+        poisson_ratio=nu if nu is not None else mat.poisson_ratio,
+        yield_strength_Pa=yield_ or mat.yield_strength_Pa,
+        stall_torque_Nm=stall_torque_nm or st.load_cases.stall_torque_Nm,
+        impact_torque_Nm=impact_torque_nm or st.load_cases.impact_torque_Nm,
+        bearing_radius_mm=bearing, elements_across_beam=across, beam_width_mm=width, backend=mesher,
+        out_dir=out_dir, export_ccx_dir=ccx_dir, name=name,
+    )
+    click.echo(f"{name}: {mat.name}, mesh {mesher} at {across:g} elements across {width:g} mm")
+    for key, label, unit in SUMMARY:
+        click.echo(f"  {label:<52} {results[key]:>12.5g} {unit}")
+    click.echo(f"written: {out_dir / (name + '.json')}, {out_dir / (name + '.vtu')}")
+    if ccx_dir is not None:
+        click.echo(f"CalculiX decks: {Path(ccx_dir) / 'stall.inp'}, {Path(ccx_dir) / 'impact.inp'} (run: ccx -i stall)")
