@@ -37,3 +37,4 @@ from seadesign.cli import corrector_cmds  # noqa: E402,F401
 from seadesign.cli import data_cmds  # noqa: E402,F401
 from seadesign.cli import sweep_cmds  # noqa: E402,F401
 from seadesign.cli import loop_cmds  # noqa: E402,F401
+from seadesign.cli import fea_cmds  # noqa: E402,F401
