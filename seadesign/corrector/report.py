@@ -60,7 +60,7 @@ def write_table(df: pd.DataFrame, out_dir: str | Path, stem: str, context: dict 
 
 
 def plot_predictions(traces: dict[str, dict], out_path: str | Path, knee: int = 0, n_steps: int = 400) -> Path:
-    """Prediction (blue) vs recorded motor position (red) over the same held-out steps, one panel per
+    """Prediction (blue) vs the recorded task output (red) over the same held-out steps, one panel per
     candidate (as thesis figs. 6.5 / C.1). Uses the first contiguous run of `knee` (0 left, 1 right)."""
     first = next(iter(traces.values()))
     sel = np.flatnonzero(first["knee"] == knee)
@@ -72,7 +72,7 @@ def plot_predictions(traces: dict[str, dict], out_path: str | Path, knee: int = 
     sel = sel[: min(end, n_steps)]
     fig, axes = plt.subplots(len(traces), 1, figsize=(9, 1.8 * len(traces)), sharex=True, squeeze=False)
     for ax, (name, tr) in zip(axes[:, 0], traces.items()):
-        ax.plot(tr["truth"][sel], color="red", lw=1.2, label="recorded motor position t+1")
+        ax.plot(tr["truth"][sel], color="red", lw=1.2, label="recorded (task output)")
         ax.plot(tr["pred"][sel], color="blue", lw=1.0, label="command")
         ax.set_ylabel("rad")
         ax.set_title(name, fontsize=9, loc="left")
