@@ -236,7 +236,7 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     a.done()
 
     m = top.table("mesh")
-    mesh = MeshSettings(m.number("elements_across_beam", gt=0), m.string("backend", "pytetwild"))
+    mesh = MeshSettings(m.number("elements_across_beam", gt=0), m.string("backend", "gmsh"))
     m.done()
     if mesh.backend not in ("pytetwild", "gmsh"):
         raise m.error(m.key("backend"), f"must be 'pytetwild' or 'gmsh', got '{mesh.backend}'")
