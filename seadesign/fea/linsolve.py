@@ -30,6 +30,7 @@ class SPDFactorization:
         a = sp.csr_matrix(a)
         self.n = a.shape[0]
         self.backend = backend
+        self._solver = None
         if backend == "pardiso":
             self._upper = sp.triu(a, format="csr")
             self._upper.sort_indices()
@@ -47,6 +48,16 @@ class SPDFactorization:
                 raise SolverError(f"SuperLU factorization failed: {exc}; the structure may be under-constrained") from None
         else:
             raise SolverError(f"unknown linear solver backend {backend!r}; use 'pardiso' or 'scipy'")
+
+    def close(self) -> None:
+        """Release PARDISO's factorization memory (MKL keeps it outside Python's heap, and
+        pypardiso does not free it when the solver object is collected)."""
+        if self.backend == "pardiso" and self._solver is not None:
+            self._solver.free_memory(everything=True)
+            self._solver = None
+
+    def __del__(self) -> None:
+        self.close()
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solution of A x = b for one (n,) or several (n, r) right-hand sides."""

@@ -98,6 +98,7 @@ def solve_unit_torsion(
     rhs = np.zeros(kr.shape[0])
     rhs[cpl.ref_dofs[5]] = 1.0  # 1 Nm about +z
     q = fact.solve(rhs)
+    fact.close()
     u = tt @ q
     f = k @ u
     t4 = time.perf_counter()
