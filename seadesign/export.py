@@ -60,6 +60,13 @@ def write_stl(solid: cq.Shape, path: str | Path, tolerance_mm: float = 0.01) -> 
     return path
 
 
+def export_candidate(c, folder: str | Path, tolerance_mm: float = 0.01) -> list[Path]:
+    """STL + STEP of a checked candidate (`candidates.CheckedPart`), named by its parameters."""
+    folder = Path(folder)
+    stem = f"{c.params.beam_count}beams_{c.params.beam_thickness_mm:g}mm"
+    return [write_stl(c.part.solid, folder / f"{stem}.stl", tolerance_mm), write_step(c.part.solid, folder / f"{stem}.step")]
+
+
 def write_step(solid: cq.Shape, path: str | Path) -> Path:
     """Write a STEP file (mm)."""
     path = Path(path)

@@ -9,8 +9,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from seadesign.errors import ConfigError
-from seadesign.tomlcheck import Table, read_toml
+from seadesign.tomlcheck import Table, find_toml, read_toml
 
 MATERIALS_DIR = Path(__file__).resolve().parents[1] / "materials"
 
@@ -104,10 +103,4 @@ def load_material_file(path: str | Path) -> Material:
 
 def load_material(name_or_path: str | Path, materials_dir: Path = MATERIALS_DIR) -> Material:
     """Load a material by file stem (e.g. "ninjaflex") from `materials/`, or by path."""
-    path = Path(name_or_path)
-    if path.suffix != ".toml":
-        path = materials_dir / f"{name_or_path}.toml"
-    if not path.exists():
-        known = ", ".join(sorted(p.stem for p in materials_dir.glob("*.toml")))
-        raise ConfigError(f"material '{name_or_path}' not found ({path}); known materials: {known}")
-    return load_material_file(path)
+    return load_material_file(find_toml(name_or_path, materials_dir, "material", "materials"))

@@ -14,7 +14,7 @@ from pathlib import Path
 from seadesign.errors import ConfigError
 from seadesign.materials import Material, load_material
 from seadesign.params import BoltPattern, GeometryParams, NutSlots, ValidityRules
-from seadesign.tomlcheck import Table, read_toml
+from seadesign.tomlcheck import Table, find_toml, read_toml
 
 STUDIES_DIR = Path(__file__).resolve().parents[1] / "studies"
 DEFAULT_STUDY = STUDIES_DIR / "wolfgang_knee.toml"
@@ -183,12 +183,7 @@ def _geometry(t: Table) -> dict:
 
 def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     """Load and validate a study by path or by name (a file stem in `studies/`)."""
-    path = Path(path)
-    if path.suffix != ".toml":
-        path = STUDIES_DIR / f"{path}.toml"
-    if not path.exists():
-        known = ", ".join(sorted(p.stem for p in STUDIES_DIR.glob("*.toml")))
-        raise ConfigError(f"study '{path}' not found; known studies: {known}")
+    path = find_toml(path, STUDIES_DIR, "study", "studies")
     top = Table(read_toml(path), path)
     name = top.string("name")
     description = top.string("description")

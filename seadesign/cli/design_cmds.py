@@ -8,7 +8,7 @@ import click
 
 from seadesign.candidates import check_candidate, find_candidate
 from seadesign.cli import main
-from seadesign.export import write_step, write_stl
+from seadesign.export import export_candidate
 from seadesign.study import DEFAULT_STUDY, load_study
 
 STUDY_ARG = click.argument("study", default=str(DEFAULT_STUDY.stem), required=False)
@@ -49,8 +49,3 @@ def export(study: str, beam_count: int, thickness_mm: float, tolerance_mm: float
     for path in export_candidate(c, out_dir / s.name, tolerance_mm):
         click.echo(f"wrote {path}")
 
-
-def export_candidate(c, folder: Path, tolerance_mm: float) -> list[Path]:
-    """STL + STEP of a checked candidate, named by its parameters."""
-    stem = f"{c.params.beam_count}beams_{c.params.beam_thickness_mm:g}mm"
-    return [write_stl(c.part.solid, folder / f"{stem}.stl", tolerance_mm), write_step(c.part.solid, folder / f"{stem}.step")]

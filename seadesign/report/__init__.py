@@ -42,7 +42,7 @@ def write_tables(t: pd.DataFrame, settings: dict, folder: Path) -> list[Path]:
 def export_cad(study: Study, rows: pd.DataFrame, folder: Path, tolerance_mm: float) -> list[Path]:
     """STL + STEP of the given candidates; files whose geometry key is unchanged are kept."""
     from seadesign.candidates import check_candidate
-    from seadesign.cli.design_cmds import export_candidate
+    from seadesign.export import export_candidate
 
     out = []
     for _, r in rows.iterrows():
