@@ -66,3 +66,18 @@ def test_bad_study_is_refused_naming_the_key(tmp_path, old, new, message):
 def test_unknown_study_lists_known():
     with pytest.raises(ConfigError, match="known studies: .*wolfgang_knee"):
         load_study("nonexistent_study")
+
+
+def test_every_lazy_command_resolves_and_every_command_is_listed():
+    import importlib
+
+    import click
+
+    from seadesign.cli import COMMAND_MODULES, main
+
+    ctx = click.Context(main)
+    for name in COMMAND_MODULES:
+        assert isinstance(main.get_command(ctx, name), click.Command), name
+    for module in set(COMMAND_MODULES.values()):
+        importlib.import_module(f"seadesign.cli.{module}")
+    assert set(main.commands) == set(COMMAND_MODULES)  # no command defined but missing from the map

@@ -118,6 +118,30 @@ def test_modulus_change_resolves_on_the_cached_mesh(tiny, tmp_path):
     assert r.rows.loc[0, "k_Nm_per_rad"] == pytest.approx(2 * base.rows.loc[0, "k_Nm_per_rad"], rel=1e-6)
 
 
+def test_warm_rerun_keeps_unchanged_outputs_and_redraws_changed_ones(tiny, tmp_path):
+    study_path, cache_dir, out = tiny
+    folder = out / "tiny"
+    kept = ["pareto.png", "k_vs_beams.png", "reaction_displacement.png", "3beams_8mm.stl", "3beams_8mm.step"]
+    before = {n: (folder / n).stat().st_mtime_ns for n in kept}
+    args = ["sweep", str(study_path), "--jobs", "1", "--quiet", "--out", str(out), "--cache-dir", str(cache_dir)]
+    assert CliRunner().invoke(main, args).exit_code == 0
+    assert {n: (folder / n).stat().st_mtime_ns for n in kept} == before
+    # a heavier stall torque changes the table: the plots are redrawn, the unchanged geometry is not re-exported
+    heavier = write_tiny_study(tmp_path, stall_torque_Nm="23.4")
+    (tmp_path / "exports").mkdir()
+    for n in kept:
+        (tmp_path / "exports" / "tiny").mkdir(exist_ok=True)
+        (tmp_path / "exports" / "tiny" / n).write_bytes((folder / n).read_bytes())
+        (tmp_path / "exports" / "tiny" / f".{n}.key").write_bytes((folder / f".{n}.key").read_bytes())
+    copied = {n: (tmp_path / "exports" / "tiny" / n).stat().st_mtime_ns for n in kept}
+    args = ["sweep", str(heavier), "--jobs", "1", "--quiet", "--out", str(tmp_path / "exports"),
+            "--cache-dir", str(cache_dir)]
+    assert CliRunner().invoke(main, args).exit_code == 0
+    after = {n: (tmp_path / "exports" / "tiny" / n).stat().st_mtime_ns for n in kept}
+    assert all(after[n] != copied[n] for n in kept if n.endswith(".png"))
+    assert all(after[n] == copied[n] for n in kept if not n.endswith(".png"))
+
+
 def test_failing_candidate_is_recorded_and_the_sweep_goes_on(tmp_path, monkeypatch):
     import seadesign.stages as stages
 

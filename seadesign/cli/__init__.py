@@ -5,14 +5,35 @@ Each group of subcommands lives in its own module and registers itself on `main`
 
 from __future__ import annotations
 
+import importlib
+
 import click
 
 from seadesign import __version__
 from seadesign.errors import SeadesignError
 
 
+# Subcommand modules register themselves on `main` when imported; each is imported only when one
+# of its commands runs (or for the command list), so `seadesign sweep` does not load torch.
+COMMAND_MODULES = {
+    "geometry": "design_cmds", "export": "design_cmds", "solve": "fea_cmds", "sweep": "sweep_cmds",
+    "data": "data_cmds", "simulate": "data_cmds", "simulate-bench": "data_cmds", "effects": "data_cmds",
+    "train": "corrector_cmds", "evaluate": "corrector_cmds", "iterate": "corrector_cmds",
+    "explain": "loop_cmds", "explain-thesis": "loop_cmds",
+}
+
+
 class _Group(click.Group):
-    """Click group that turns SeadesignError into a clean one-line error (exit code 2)."""
+    """Click group with lazily imported subcommands that turns SeadesignError into a clean
+    one-line error (exit code 2)."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:  # noqa: D102
+        return sorted(COMMAND_MODULES)
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:  # noqa: D102
+        if name not in self.commands and name in COMMAND_MODULES:
+            importlib.import_module(f"seadesign.cli.{COMMAND_MODULES[name]}")
+        return super().get_command(ctx, name)
 
     def invoke(self, ctx: click.Context):  # noqa: D102
         try:
@@ -30,11 +51,3 @@ def main() -> None:
     everything else is SI (N, m, Pa, Nm, rad).
     """
 
-
-# Subcommand modules register themselves on `main` when imported.
-from seadesign.cli import design_cmds  # noqa: E402,F401
-from seadesign.cli import corrector_cmds  # noqa: E402,F401
-from seadesign.cli import data_cmds  # noqa: E402,F401
-from seadesign.cli import sweep_cmds  # noqa: E402,F401
-from seadesign.cli import loop_cmds  # noqa: E402,F401
-from seadesign.cli import fea_cmds  # noqa: E402,F401

@@ -15,8 +15,6 @@ from seadesign.handoff import write_spring
 from seadesign.rank import Choice
 from seadesign.report.document import write_html, write_markdown
 from seadesign.report.handoff import spring_document
-from seadesign.report.plots import fig_k, fig_pareto, fig_reaction_displacement
-from seadesign.report.renders import render_case
 from seadesign.stages import SolverSettings, fea_key, geometry_key
 from seadesign.study import Study
 
@@ -39,23 +37,79 @@ def write_tables(t: pd.DataFrame, settings: dict, folder: Path) -> list[Path]:
     return paths
 
 
+def up_to_date(files: list[Path], key: str) -> bool:
+    """True when every file exists and was written from inputs hashing to `key` (see `stamp`)."""
+    return all(f.exists() and _stamp_path(f).exists() and _stamp_path(f).read_text() == key for f in files)
+
+
+def stamp(files: list[Path], key: str) -> None:
+    """Record that `files` were written from inputs hashing to `key` (hidden .<name>.key beside each)."""
+    for f in files:
+        _stamp_path(f).write_text(key)
+
+
+def _stamp_path(file: Path) -> Path:
+    return file.with_name(f".{file.name}.key")
+
+
 def export_cad(study: Study, rows: pd.DataFrame, folder: Path, tolerance_mm: float) -> list[Path]:
     """STL + STEP of the given candidates; files whose geometry key is unchanged are kept."""
-    from seadesign.candidates import check_candidate
-    from seadesign.export import export_candidate
-
     out = []
     for _, r in rows.iterrows():
         params = study.params(int(r["beam_count"]), float(r["beam_thickness_mm"]))
         stem = f"{params.beam_count}beams_{params.beam_thickness_mm:g}mm"
         files = [folder / f"{stem}.stl", folder / f"{stem}.step"]
-        stamp = folder / f".{stem}.key"
         key = digest(geometry_key(study, params), tolerance_mm)
-        if all(f.exists() for f in files) and stamp.exists() and stamp.read_text() == key:
-            out += files
-            continue
-        out += export_candidate(check_candidate(study, params), folder, tolerance_mm)
-        stamp.write_text(key)
+        if not up_to_date(files, key):
+            from seadesign.candidates import check_candidate  # CadQuery: only when a file is (re)written
+            from seadesign.export import export_candidate
+
+            export_candidate(check_candidate(study, params), folder, tolerance_mm)
+            stamp(files, key)
+        out += files
+    return out
+
+
+def write_plots(t: pd.DataFrame, choice: Choice, folder: Path) -> dict[str, Path]:
+    """The sweep's figures by caption; unchanged results keep their PNGs."""
+    from seadesign.report.plots import fig_k, fig_pareto, fig_reaction_displacement
+
+    figures = {
+        "Reaction force and displacement vs beam count (thesis fig. 5.3 analogue)":
+            (fig_reaction_displacement, folder / "reaction_displacement.png"),
+        "k vs beam count": (fig_k, folder / "k_vs_beams.png"),
+        "Pareto front": (lambda table, path: fig_pareto(table, choice.index, path), folder / "pareto.png"),
+    }
+    numbers = t.drop(columns=["elapsed_s", "traceback"], errors="ignore")
+    key = digest("plots", numbers[sorted(numbers.columns)].to_json(), choice.index)
+    paths = [path for _, path in figures.values()]
+    if not up_to_date(paths, key):
+        for draw, path in figures.values():
+            draw(t, path)
+        stamp(paths, key)
+    return {caption: path for caption, (_, path) in figures.items()}
+
+
+def write_renders(study: Study, row: pd.Series, folder: Path, solver: SolverSettings,
+                  cache: Cache) -> dict[str, Path]:
+    """Renders of the chosen candidate under both load cases, by caption (none when its FEA is not
+    cached or off-screen rendering is unavailable); unchanged inputs keep their PNGs."""
+    from seadesign.report.renders import render_case
+
+    params = study.params(int(row["beam_count"]), float(row["beam_thickness_mm"]))
+    key_fea = fea_key(study, params, solver)
+    out = {}
+    for case in ("stall", "impact"):
+        torque = float(row[f"{case}_torque_Nm"])
+        title = f"{row['candidate']}: {case}, {torque:.3g} Nm"
+        path = folder / f"chosen_{case}.png"
+        key = digest("render", key_fea, torque, title)
+        if not up_to_date([path], key):
+            unit = cache.get("fea", key_fea)
+            if unit is None or render_case(unit, case, torque, title, path) is None:
+                continue
+            stamp([path], key)
+        out[f"Chosen part under the {case} load case (colour: von Mises, MPa)"] = path
     return out
 
 
@@ -65,23 +119,11 @@ def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, s
     """Write every output of a ranked sweep; returns paths by kind."""
     folder.mkdir(parents=True, exist_ok=True)
     written: dict[str, list[Path]] = {"tables": write_tables(t, settings, folder)}
-    images = {
-        "Reaction force and displacement vs beam count (thesis fig. 5.3 analogue)":
-            fig_reaction_displacement(t, folder / "reaction_displacement.png"),
-        "k vs beam count": fig_k(t, folder / "k_vs_beams.png"),
-        "Pareto front": fig_pareto(t, choice.index, folder / "pareto.png"),
-    }
+    images = write_plots(t, choice, folder)
     cad_rows = t[t["status"] != "invalid"] if export_all else t.iloc[[]]
     if choice.index is not None:
         row = t.loc[choice.index]
-        params = study.params(int(row["beam_count"]), float(row["beam_thickness_mm"]))
-        unit = cache.get("fea", fea_key(study, params, solver))
-        for case in ("stall", "impact"):
-            torque = float(row[f"{case}_torque_Nm"])
-            path = render_case(unit, case, torque, f"{row['candidate']}: {case}, {torque:.3g} Nm",
-                               folder / f"chosen_{case}.png") if unit is not None else None
-            if path is not None:
-                images[f"Chosen part under the {case} load case (colour: von Mises, MPa)"] = path
+        images.update(write_renders(study, row, folder, solver, cache))
         if not export_all:
             cad_rows = t.loc[[choice.index]]
         selection = {"feasible": choice.feasible, "failed_constraints": str(row["failed_constraints"]),
