@@ -1,8 +1,8 @@
 """Where sweep tasks run: in this process, in a local process pool, or on a Dask cluster.
 
 Every executor takes a task function `fn(task, sink)` and yields `(task, result)` as results
-arrive. `sink.put((task_id, stage))` reports the stage a task has started; executors that
-cannot carry it across machines pass a sink that drops it.
+arrive. `sink.put((task_id, stage))` reports the stage a task has started; each executor carries
+it back to `on_stage` (a callback, a process queue, or a Dask distributed Queue).
 """
 
 from __future__ import annotations
@@ -10,6 +10,8 @@ from __future__ import annotations
 import multiprocessing as mp
 import os
 import queue
+import time
+import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any, Callable, Iterator
 
@@ -31,12 +33,6 @@ class _CallbackSink:
     def put(self, message: tuple[Any, str]) -> None:
         self.on_stage(*message)
 
-
-class NullSink:
-    """A sink that drops stage messages."""
-
-    def put(self, message: tuple[Any, str]) -> None:
-        return None
 
 
 def run_serial(fn, tasks: list, on_stage: Callable[[Any, str], None], on_tick: Callable[[], None]) -> Iterator:
@@ -74,11 +70,28 @@ def _drain(sink, on_stage: Callable[[Any, str], None]) -> None:
             return
 
 
-def run_dask(fn, tasks: list, scheduler: str | None, jobs: int, on_tick: Callable[[], None]) -> Iterator:
+class _DaskSink:
+    """Stage messages from Dask workers through a distributed Queue held by the scheduler."""
+
+    def __init__(self, queue) -> None:
+        self.queue = queue
+
+    def put(self, message) -> None:
+        self.queue.put(list(message))
+
+    def drain(self, on_stage: Callable[[Any, str], None]) -> None:
+        if self.queue.qsize():
+            for task_id, stage in self.queue.get(batch=True):
+                on_stage(task_id, stage)
+
+
+def run_dask(fn, tasks: list, scheduler: str | None, jobs: int, on_stage: Callable[[Any, str], None],
+             on_tick: Callable[[], None]) -> Iterator:
     """Tasks on a Dask distributed cluster at `scheduler` (host:port), or on a LocalCluster of
-    `jobs` single-threaded worker processes when no address is given."""
+    `jobs` single-threaded worker processes when no address is given; stage messages come back
+    through a distributed Queue."""
     try:
-        from distributed import Client, LocalCluster, as_completed
+        from distributed import Client, LocalCluster, Queue
     except ImportError:
         raise ExecutorError("--executor dask needs the 'distributed' package: pip install 'dask[distributed]'") from None
     cluster = None
@@ -91,9 +104,17 @@ def run_dask(fn, tasks: list, scheduler: str | None, jobs: int, on_tick: Callabl
     except OSError as exc:
         raise ExecutorError(f"--scheduler {scheduler}: cannot connect ({exc}); check the address (host:port)") from None
     try:
-        futures = {client.submit(fn, task, NullSink(), pure=False): task for task in tasks}
-        for fut in as_completed(futures):
-            yield futures[fut], fut.result()
+        sink = _DaskSink(Queue(f"seadesign-stages-{uuid.uuid4().hex}", client=client))
+        futures = {client.submit(fn, task, sink, pure=False): task for task in tasks}
+        pending = list(futures)
+        while pending:
+            done = [f for f in pending if f.done()]
+            pending = [f for f in pending if not f.done()]
+            sink.drain(on_stage)
+            for fut in done:
+                yield futures[fut], fut.result()
+            if pending:
+                time.sleep(POLL_S)
             on_tick()
     finally:
         client.close()
@@ -112,7 +133,7 @@ def execute(fn, tasks: list, executor: str, jobs: int, scheduler: str | None,
     if jobs < 1:
         raise ExecutorError(f"--jobs must be >= 1 (got {jobs})")
     if executor == "dask":
-        return run_dask(fn, tasks, scheduler, jobs, on_tick)
+        return run_dask(fn, tasks, scheduler, jobs, on_stage, on_tick)
     if executor != "local":
         raise ExecutorError(f"--executor must be 'local' or 'dask' (got {executor!r})")
     if scheduler:
