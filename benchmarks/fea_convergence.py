@@ -2,10 +2,12 @@
 fresh pytetwild meshings.
 
 Usage: python benchmarks/fea_convergence.py [--study wolfgang_knee] [--candidates 3x4,8x6,6x8]
-       [--sizes 1.5,2,3] [--backend gmsh] [--spread N]
-Prints, per candidate, k at each elements-across-beam setting, the extrapolated k, the observed
-order and each size's estimated discretization error; with --spread N, N fresh pytetwild meshes
-of the first candidate at the study's size and the spread (max - min) / mean of k.
+       [--refinements 0.667,1,1.5,2.25] [--backend gmsh] [--spread N]
+Prints, per candidate, k at each refinement (a factor on the study's elements across the beam
+elements per turn on curved surfaces and layers: 1 is the study's default mesh), the extrapolated k,
+the observed order, each size's estimated discretization error, and the sweep's two-level
+estimate at the default (default vs the 1.5x coarser mesh) next to it; with --spread N, N fresh
+pytetwild meshes of the first candidate at the study's size and the spread (max - min) / mean of k.
 """
 
 from __future__ import annotations
@@ -22,12 +24,17 @@ from seadesign.candidates import check_candidate, find_candidate
 from seadesign.fea.convergence import richardson
 from seadesign.fea.torsion import solve_unit_torsion
 from seadesign.mesh import mesh_part
+from seadesign.stages import COARSENING, CONVERGENCE_ORDER
 from seadesign.study import load_study
 
 
-def k_at(st, part, width, across, backend, cache_dir) -> tuple[float, int, float]:
+def k_at(st, part, width, refinement, backend, cache_dir) -> tuple[float, int, float]:
     t = time.perf_counter()
-    mesh = mesh_part(part.solid, part.interfaces, across, width, cache_dir=cache_dir, backend=backend)
+    sizing = st.mesh.scaled(refinement)
+    if backend == "pytetwild":
+        sizing.update(elements_per_circle=0.0, layers=0)
+    mesh = mesh_part(part.solid, part.interfaces, beam_width_mm=width, cache_dir=cache_dir,
+                     **{**sizing, "backend": backend}, max_tets=1_500_000, timeout_s=600)
     sol = solve_unit_torsion(mesh, st.material.youngs_modulus_Pa, st.material.poisson_ratio)
     return 1.0 / float(sol.hub_motion[5]), len(mesh.tets), time.perf_counter() - t
 
@@ -36,15 +43,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--study", default="wolfgang_knee")
     ap.add_argument("--candidates", default="3x4,8x6,6x8", help="beams x thickness_mm, comma separated")
-    ap.add_argument("--sizes", default="1.5,2,3", help="elements across the beam")
+    ap.add_argument("--refinements", default="0.667,1,1.5,2.25", help="factors on the study's mesh density")
     ap.add_argument("--backend", choices=["gmsh", "pytetwild"], default="gmsh")
     ap.add_argument("--spread", type=int, default=0, help="fresh pytetwild meshings for the spread of k")
     args = ap.parse_args()
     st = load_study(args.study)
-    sizes = [float(s) for s in args.sizes.split(",")]
+    refinements = [float(s) for s in args.refinements.split(",")]
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
     print(f"study {st.name}, material {st.material.name}, backend {args.backend}, study default "
-          f"{st.mesh.elements_across_beam:g} elements across the beam")
+          f"{st.mesh.elements_across_beam:g} elements across the beam, {st.mesh.elements_per_circle:g} per turn "
+          f"on curved surfaces")
     parts = []
     for spec in args.candidates.split(","):
         n, w = spec.split("x")
@@ -57,22 +65,28 @@ def main() -> None:
         for n, w, part in parts:
             hs, ks = [], []
             print(f"\n{n} beams / {w:g} mm")
-            print(f"{'across':>7}{'h mm':>8}{'tets':>9}{'k Nm/rad':>12}{'s':>8}")
-            for across in sizes:
-                k, tets, s = k_at(st, part, w, across, args.backend, cache)
-                hs.append(w / across)
+            print(f"{'refine':>7}{'h mm':>8}{'tets':>9}{'k Nm/rad':>12}{'s':>8}")
+            for f in refinements:
+                k, tets, s = k_at(st, part, w, f, args.backend, cache)
+                hs.append(1.0 / f)  # relative element size
                 ks.append(k)
-                print(f"{across:>7g}{w / across:>8.3f}{tets:>9}{k:>12.5f}{s:>8.1f}", flush=True)
+                print(f"{f:>7g}{w / (f * st.mesh.elements_across_beam):>8.3f}{tets:>9}{k:>12.5f}{s:>8.1f}", flush=True)
             r = richardson(hs, ks)
-            print(f"Richardson: k0 = {r['extrapolated']:.5f} Nm/rad, observed order {r['order']:.2f}")
-            for h in hs:
-                print(f"  estimated error at h = {h:.3f} mm: {100 * r[f'rel_error_h={h:g}']:.2f} %")
+            print(f"Richardson (finest three): k0 = {r['extrapolated']:.5f} Nm/rad, observed order {r['order']:.2f}")
+            for f, h, k in zip(refinements, hs, ks):
+                print(f"  refinement {f:g}: error against k0 {100 * (k - r['extrapolated']) / r['extrapolated']:+.2f} %")
+            if 1.0 in refinements and 1 / COARSENING in [round(f, 3) for f in refinements]:
+                k1 = ks[refinements.index(1.0)]
+                kc = ks[[round(f, 3) for f in refinements].index(1 / COARSENING)]
+                est = abs(kc - k1) / k1 / (COARSENING**CONVERGENCE_ORDER - 1.0)
+                print(f"  sweep's two-level estimate at the default: {100 * est:.2f} % "
+                      f"(order {CONVERGENCE_ORDER:g} assumed)")
         if args.spread and parts:
             n, w, part = parts[0]
             ks = []
             for i in range(args.spread):
                 with tempfile.TemporaryDirectory() as fresh:
-                    k, tets, s = k_at(st, part, w, st.mesh.elements_across_beam, "pytetwild", fresh)
+                    k, tets, s = k_at(st, part, w, 1.0, "pytetwild", fresh)
                 ks.append(k)
                 print(f"pytetwild fresh mesh {i + 1}: {tets} tets, k = {k:.5f} Nm/rad ({s:.0f} s)", flush=True)
             ks = np.array(ks)

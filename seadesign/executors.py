@@ -7,6 +7,7 @@ it back to `on_stage` (a callback, a process queue, or a Dask distributed Queue)
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing as mp
 import os
 import queue
@@ -47,7 +48,9 @@ def run_processes(fn, tasks: list, jobs: int, on_stage: Callable[[Any, str], Non
                   on_tick: Callable[[], None]) -> Iterator:
     """Tasks in a pool of `jobs` fresh ("spawn") processes; stage messages through a managed queue."""
     ctx = mp.get_context("spawn")
-    with ctx.Manager() as manager, ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+    threads = str(max(1, default_jobs() // jobs))  # solver threads per worker: no oversubscription
+    with _environment(MKL_NUM_THREADS=threads, OMP_NUM_THREADS=threads), ctx.Manager() as manager, \
+            ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
         sink = manager.Queue()
         pending = {pool.submit(fn, task, sink): task for task in tasks}
         try:
@@ -60,6 +63,19 @@ def run_processes(fn, tasks: list, jobs: int, on_stage: Callable[[Any, str], Non
         finally:
             for fut in pending:
                 fut.cancel()
+
+
+@contextlib.contextmanager
+def _environment(**values: str):
+    """Environment variables set while worker processes are spawned (they inherit them); the
+    caller's own values are respected."""
+    added = {k: v for k, v in values.items() if k not in os.environ}
+    os.environ.update(added)
+    try:
+        yield
+    finally:
+        for k in added:
+            os.environ.pop(k, None)
 
 
 def _drain(sink, on_stage: Callable[[Any, str], None]) -> None:

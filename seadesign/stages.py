@@ -27,7 +27,7 @@ from seadesign.study import Study
 
 Progress = Callable[[str], None]  # receives the name of the stage that starts
 COARSENING = 1.5  # edge-length ratio of the error-estimate mesh to the result mesh
-CONVERGENCE_ORDER = 1.0  # observed order of k with h (fillets and coupling edges limit it)
+CONVERGENCE_ORDER = 1.1  # smallest order of k observed in benchmarks/fea_convergence.py (1.10-1.89)
 
 
 @dataclass(frozen=True)
@@ -96,11 +96,11 @@ def check_geometry(study: Study, params: GeometryParams, cache: Cache) -> tuple[
 def tetrahedralize(study: Study, params: GeometryParams, checked, cache: Cache, coarsening: float = 1.0):
     """Tetrahedral mesh (mm) of a checked part with named interface boundaries (mesh package,
     its own content-addressed cache under the sweep cache's root); `coarsening` > 1 makes the
-    elements that many times longer."""
+    elements that many times longer (beam, curvature and layer sizing alike)."""
     from seadesign.mesh import mesh_part
 
-    return mesh_part(checked.part.solid, checked.part.interfaces, study.mesh.elements_across_beam / coarsening,
-                     params.beam_thickness_mm, cache_dir=Path(cache.root) / "mesh", backend=study.mesh.backend)
+    return mesh_part(checked.part.solid, checked.part.interfaces, beam_width_mm=params.beam_thickness_mm,
+                     cache_dir=Path(cache.root) / "mesh", **study.mesh.scaled(1.0 / coarsening))
 
 
 def unit_response(mesh, coarse_mesh, study: Study, settings: SolverSettings) -> UnitResponse:

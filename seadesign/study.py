@@ -71,6 +71,14 @@ class Actuator:
 class MeshSettings:
     elements_across_beam: float  # target tetrahedra across the beam width
     backend: str  # "pytetwild" or "gmsh"
+    elements_per_circle: float = 0.0  # gmsh: curved surfaces (bolt holes, fillets) get this many elements per turn
+    layers: float = 0.0  # gmsh, prismatic parts: layers through the thickness (0: about one per element size)
+
+    def scaled(self, refinement: float) -> dict:
+        """mesh_part keyword arguments at `refinement` times this density (1: as given)."""
+        return {"elements_across_beam": self.elements_across_beam * refinement,
+                "elements_per_circle": self.elements_per_circle * refinement,
+                "layers": math.ceil(self.layers * refinement - 1e-9), "backend": self.backend}
 
 
 @dataclass(frozen=True)
@@ -231,10 +239,14 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     a.done()
 
     m = top.table("mesh")
-    mesh = MeshSettings(m.number("elements_across_beam", gt=0), m.string("backend", "gmsh"))
+    mesh = MeshSettings(m.number("elements_across_beam", gt=0), m.string("backend", "gmsh"),
+                        m.number("elements_per_circle", 0.0, ge=0), m.number("layers", 0.0, ge=0))
     m.done()
     if mesh.backend not in ("pytetwild", "gmsh"):
         raise m.error(m.key("backend"), f"must be 'pytetwild' or 'gmsh', got '{mesh.backend}'")
+    if mesh.backend != "gmsh" and mesh.elements_per_circle > 0:
+        raise m.error(m.key("elements_per_circle"), "curvature-based sizing needs backend = 'gmsh'; set it to 0 "
+                                                    "for pytetwild")
 
     rk = top.table("ranking")
     ranking = Ranking(

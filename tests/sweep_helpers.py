@@ -14,7 +14,7 @@ def write_tiny_study(folder: Path, name: str = "tiny", **replace: str) -> Path:
     key to its new TOML value text (first occurrence)."""
     text = DEFAULT_STUDY.read_text()
     values = {"name": f'"{name}"', "beam_count": "[3, 10]", "beam_thickness_mm": "[8.0]",
-              "elements_across_beam": "0.6", **replace}
+              "elements_across_beam": "0.6", "elements_per_circle": "0", "layers": "2", **replace}
     for key, value in values.items():
         text, n = re.subn(rf"(?m)^{key}\s*=\s*[^#\n]*", f"{key} = {value}  ", text, count=1)
         assert n == 1, key

@@ -46,13 +46,16 @@ SUMMARY = (
 @click.option("--impact-torque-Nm", type=float, help="Default: the study's (for --stl: the default study's).")
 @click.option("--bearing-radius-mm", type=float, help="Default: the study's; for --stl the detected hub radius.")
 @click.option("--elements-across-beam", type=float, help="Mesh density; default: the study's (3 for --stl).")
+@click.option("--elements-per-circle", type=click.FloatRange(min=0), default=None,
+              help="gmsh: elements per full turn on curved surfaces (holes, fillets); default: the study's (0 = "
+                   "uniform, the only choice for pytetwild).")
 @click.option("--backend", type=click.Choice(["gmsh", "pytetwild"]), help="Mesher; default: the study's (STL: pytetwild).")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
               help="Where to write NAME.json and NAME.vtu; default exports/<study or STL name>/.")
 @click.option("--export-ccx", "ccx_dir", type=click.Path(file_okay=False, path_type=Path),
               help="Also write CalculiX decks stall.inp and impact.inp here.")
 def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs, nu, yield_, stall_torque_nm,
-          impact_torque_nm, bearing_radius_mm, elements_across_beam, backend, out_dir, ccx_dir) -> None:
+          impact_torque_nm, bearing_radius_mm, elements_across_beam, elements_per_circle, backend, out_dir, ccx_dir) -> None:
     """Mesh and solve the stall and impact load cases of one part; print and write the results.
 
     Either STUDY --beams N --thickness-mm T (a candidate of a study), or --stl FILE --beam-width-mm W.
@@ -76,6 +79,7 @@ def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs
         name, width = stl.stem, beam_width_mm
         bearing = bearing_radius_mm or interfaces.hub_radius_mm
         across, mesher = elements_across_beam or 3.0, backend or "pytetwild"
+        per_circle, layers = elements_per_circle or 0.0, 0
     else:
         if beams is None or thickness_mm is None:
             raise ConfigError("the study form needs --beams N and --thickness-mm T")
@@ -90,6 +94,9 @@ def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs
         bearing = bearing_radius_mm or st.bearing_radius_mm
         across = elements_across_beam or st.mesh.elements_across_beam
         mesher = backend or st.mesh.backend
+        per_circle = elements_per_circle if elements_per_circle is not None else (
+            st.mesh.elements_per_circle if mesher == "gmsh" else 0.0)
+        layers = st.mesh.scaled(1.0)["layers"] if mesher == "gmsh" else 0
     out_dir = out_dir or Path("exports") / (st.name if stl is None else stl.stem)
     results, _, _ = solve_part(
         geometry, interfaces,
@@ -99,9 +106,10 @@ def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs
         stall_torque_Nm=stall_torque_nm or st.load_cases.stall_torque_Nm,
         impact_torque_Nm=impact_torque_nm or st.load_cases.impact_torque_Nm,
         bearing_radius_mm=bearing, elements_across_beam=across, beam_width_mm=width, backend=mesher,
-        out_dir=out_dir, export_ccx_dir=ccx_dir, name=name,
+        elements_per_circle=per_circle, layers=layers, out_dir=out_dir, export_ccx_dir=ccx_dir, name=name,
     )
-    click.echo(f"{name}: {mat.name}, mesh {mesher} at {across:g} elements across {width:g} mm")
+    click.echo(f"{name}: {mat.name}, mesh {mesher} at {across:g} elements across {width:g} mm"
+               + (f", {per_circle:g} per turn on curved surfaces" if per_circle else ""))
     for key, label, unit in SUMMARY:
         click.echo(f"  {label:<52} {results[key]:>12.5g} {unit}")
     click.echo(f"written: {out_dir / (name + '.json')}, {out_dir / (name + '.vtu')}")

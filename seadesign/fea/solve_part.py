@@ -24,6 +24,8 @@ def solve_part(
     elements_across_beam: float,
     beam_width_mm: float,
     backend: str = "gmsh",
+    elements_per_circle: float = 0.0,
+    layers: int = 0,
     cache_dir: str | Path | None = None,
     out_dir: str | Path | None = None,
     export_ccx_dir: str | Path | None = None,
@@ -32,7 +34,8 @@ def solve_part(
     """Mesh and solve a part (CadQuery solid or closed surface); with out_dir write
     <name>.json and <name>.vtu, with export_ccx_dir the CalculiX decks stall.inp / impact.inp."""
     t0 = time.perf_counter()
-    mesh = mesh_part(solid_or_surface, interfaces, elements_across_beam, beam_width_mm, cache_dir=cache_dir, backend=backend)
+    mesh = mesh_part(solid_or_surface, interfaces, elements_across_beam, beam_width_mm, cache_dir=cache_dir,
+                     backend=backend, elements_per_circle=elements_per_circle, layers=layers)
     t1 = time.perf_counter()
     a = analyse(mesh, youngs_modulus_Pa, poisson_ratio, yield_strength_Pa, stall_torque_Nm, impact_torque_Nm,
                 bearing_radius_mm)

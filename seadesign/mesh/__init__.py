@@ -16,6 +16,7 @@ import numpy as np
 
 from seadesign.errors import MeshError
 from seadesign.mesh import cache
+from seadesign.mesh.extrude import layer_count
 from seadesign.mesh.surface import load_stl, tessellate_solid
 from seadesign.mesh.tetmesh import MeshQuality, TetMesh, build_tetmesh
 from seadesign.part import Interfaces
@@ -58,6 +59,9 @@ def mesh_part(
     beam_width_mm: float,
     cache_dir: str | Path | None = None,
     backend: str = "gmsh",
+    elements_per_circle: float = 0.0,
+    sweep: bool = True,
+    layers: int = 0,
     timeout_s: float = 120.0,
     max_tets: int = 400_000,
     retries: int = 2,
@@ -67,9 +71,12 @@ def mesh_part(
 
     solid_or_surface: a CadQuery solid (mm), or (vertices_mm (n, 3), faces (k, 3)) of a closed
     surface such as load_stl() returns. Target edge length h = beam_width_mm / elements_across_beam
-    (mm). backend "gmsh" (deterministic, CAD solids only) or "pytetwild" (any closed surface; its
-    edge length and envelope are relative to the bounding-box diagonal: edge_length_fac = h / diag,
-    epsilon as given). Each attempt runs in a child process limited to timeout_s; a failed,
+    (mm). backend "gmsh" (deterministic, CAD solids only; elements_per_circle > 0 refines curved
+    surfaces such as bolt holes and fillets to that many elements per full turn; a prismatic
+    solid is meshed as its triangulated cross-section swept through the thickness in layers of
+    about h graded toward the faces (or `layers` of them when > 0), unless sweep=False) or "pytetwild"
+    (any closed surface, uniform size; its edge length and envelope are relative to the
+    bounding-box diagonal: edge_length_fac = h / diag, epsilon as given). Each attempt runs in a child process limited to timeout_s; a failed,
     timed-out or oversized (> max_tets) attempt is retried `retries` times, then MeshError.
     Meshes are cached by content under cache_dir (default: cache.default_cache_dir()).
     """
@@ -79,17 +86,27 @@ def mesh_part(
         raise MeshError(
             f"elements_across_beam ({elements_across_beam}) and beam_width_mm ({beam_width_mm}) must be positive"
         )
+    if layers < 0:
+        raise MeshError(f"layers={layers}: give a positive number of layers, or 0 to derive it from the size")
+    if elements_per_circle < 0 or (elements_per_circle > 0 and backend != "gmsh"):
+        raise MeshError(f"elements_per_circle={elements_per_circle:g}: curvature-based sizing needs backend 'gmsh' "
+                        "and a value >= 0; use 0 for a uniform mesh")
     size_mm = beam_width_mm / elements_across_beam
     is_cad = hasattr(solid_or_surface, "exportBrep")
     t0 = time.perf_counter()
     if backend == "gmsh":
         if not is_cad:
             raise MeshError("the gmsh backend needs a CAD solid; mesh surfaces (STL) with backend='pytetwild'")
-        with tempfile.TemporaryDirectory() as d:
-            solid_or_surface.exportBrep(str(Path(d) / "part.brep"))
-            payload = (Path(d) / "part.brep").read_bytes()
         volume = float(solid_or_surface.Volume())
-        settings = {"backend": backend, "size_mm": size_mm}
+        settings = {"backend": backend, "size_mm": size_mm, "per_circle": elements_per_circle}
+        section = prismatic_section(solid_or_surface) if sweep else None
+        if section is not None:
+            face, z0, thickness = section
+            settings["swept"] = {"z0_mm": z0, "thickness_mm": thickness,
+                                 "layers": layers or layer_count(thickness, size_mm)}
+        with tempfile.TemporaryDirectory() as d:
+            (face if section is not None else solid_or_surface).exportBrep(str(Path(d) / "part.brep"))
+            payload = (Path(d) / "part.brep").read_bytes()
         inputs = {"part.brep": payload}
         tag_tol_mm = 1e-3 * size_mm
     else:
@@ -149,6 +166,26 @@ def mesh_part(
         "tetrahedralize_s": t_tet,
     }
     return build_tetmesh(points, tets, interfaces, tag_tol_mm, info)
+
+
+def prismatic_section(solid, rel_tol: float = 1e-6):
+    """(bottom face, z0_mm, thickness_mm) when the solid is a straight extrusion along z of its one
+    planar bottom face (volume = face area x height, top face alike), else None."""
+    bb = solid.BoundingBox()
+    height = bb.zmax - bb.zmin
+    volume = float(solid.Volume())
+
+    def planar_at(z: float):
+        return [f for f in solid.Faces() if f.geomType() == "PLANE" and abs(f.Center().z - z) < 1e-6 * (1 + height)
+                and abs(f.normalAt().z) > 1 - 1e-9]
+
+    bottom, top = planar_at(bb.zmin), planar_at(bb.zmax)
+    if len(bottom) != 1 or len(top) != 1 or height <= 0:
+        return None
+    area = float(bottom[0].Area())
+    if abs(area * height - volume) > rel_tol * volume or abs(float(top[0].Area()) - area) > rel_tol * area:
+        return None
+    return bottom[0], float(bb.zmin), float(height)
 
 
 def _npz_bytes(**arrays: np.ndarray) -> bytes:

@@ -1,0 +1,33 @@
+"""The thesis's trend on the default study (thesis fig. 5.3): the stall displacement falls with
+beam thickness and with beam count. Every valid candidate of the default design space is solved
+on the sweep's error-estimate mesh (1.5x coarser than the default, same sizing rules)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from seadesign.cache import Cache
+from seadesign.stages import COARSENING
+from seadesign.study import load_study
+from seadesign.sweep import run_sweep
+
+
+@pytest.mark.slow
+def test_displacement_falls_with_thickness_and_beam_count(tmp_path):
+    study = load_study("wolfgang_knee")
+    m = study.mesh
+    coarse = dataclasses.replace(m, elements_across_beam=m.elements_across_beam / COARSENING,
+                                 elements_per_circle=m.elements_per_circle / COARSENING,
+                                 layers=max(2.0, m.layers / COARSENING))
+    run = run_sweep(dataclasses.replace(study, mesh=coarse), tmp_path, cache=Cache(tmp_path / "cache"), quiet=True)
+    ok = run.rows[run.rows["status"] == "ok"]
+    assert len(ok) >= 15 and set(run.rows["status"]) <= {"ok", "invalid"}
+    d = ok.pivot_table(index="beam_count", columns="beam_thickness_mm", values="stall_bearing_displacement_mm")
+    for thickness in d.columns:  # more beams: smaller displacement
+        series = d[thickness].dropna()
+        assert series.is_monotonic_decreasing and series.is_unique, (thickness, series.to_dict())
+    for count, row in d.iterrows():  # thicker beams: smaller displacement
+        series = row.dropna()
+        assert series.is_monotonic_decreasing and series.is_unique, (count, series.to_dict())
