@@ -74,10 +74,10 @@ def mesh_part(
     (mm). backend "gmsh" (deterministic, CAD solids only; elements_per_circle > 0 refines curved
     surfaces such as bolt holes and fillets to that many elements per full turn; a prismatic
     solid is meshed as its triangulated cross-section swept through the thickness in layers of
-    about h graded toward the faces (or `layers` of them when > 0), unless sweep=False) or "pytetwild"
-    (any closed surface, uniform size; its edge length and envelope are relative to the
-    bounding-box diagonal: edge_length_fac = h / diag, epsilon as given). Each attempt runs in a child process limited to timeout_s; a failed,
-    timed-out or oversized (> max_tets) attempt is retried `retries` times, then MeshError.
+    about h graded toward the faces (or `layers` of them when > 0), unless sweep=False) or
+    "pytetwild" (any closed surface, uniform size; its edge length and envelope are relative to
+    the bounding-box diagonal: edge_length_fac = h / diag, epsilon as given). Each attempt runs
+    in a child process limited to timeout_s; a failed, timed-out or oversized (> max_tets) attempt is retried `retries` times, then MeshError.
     Meshes are cached by content under cache_dir (default: cache.default_cache_dir()).
     """
     if backend not in BACKENDS:

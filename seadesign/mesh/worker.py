@@ -30,62 +30,63 @@ GMSH_ALGORITHMS = (1, 4, 10)  # 3D: Delaunay, then Frontal, then HXT for retries
 GMSH_ALGORITHMS_2D = (6, 5, 1)  # 2D: Frontal-Delaunay, then Delaunay, then MeshAdapt
 
 
-def gmsh_brep(brep: Path, size_mm: float, per_circle: float = 0.0, attempt: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """gmsh on the exact CAD geometry, single-threaded (deterministic); size in mm, and with
-    per_circle > 0 curved surfaces get at least that many elements per full turn (bolt holes,
-    fillets). Retries switch the 3D algorithm, since repeating a deterministic failure cannot help."""
+def _gmsh_model(brep: Path, size_mm: float, per_circle: float) -> None:
+    """Start gmsh (single-threaded, so deterministic) on a BREP with the sizing options: size in
+    mm, and with per_circle > 0 at least that many elements per full turn on curved geometry."""
     import gmsh
 
     gmsh.initialize(interruptible=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.option.setNumber("General.NumThreads", 1)
+    gmsh.model.occ.importShapes(str(brep))
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size_mm)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", MIN_SIZE_FRACTION * size_mm)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", per_circle)
+
+
+def _gmsh_elements(dim: int, gmsh_type: int, nen: int) -> tuple[np.ndarray, np.ndarray]:
+    """Node coordinates (n, 3) and elements (m, nen) as 0-based indices of the generated mesh."""
+    import gmsh
+
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    types, _, nodes = gmsh.model.mesh.getElements(dim)
+    if gmsh_type not in list(types):
+        raise RuntimeError(f"gmsh produced no {'tetrahedra' if dim == 3 else 'triangles'}")
+    elements = np.asarray(nodes[list(types).index(gmsh_type)], dtype=np.int64).reshape(-1, nen)
+    index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
+    index[tags.astype(np.int64)] = np.arange(len(tags))
+    return np.asarray(coords, dtype=np.float64).reshape(-1, 3), index[elements]
+
+
+def gmsh_brep(brep: Path, size_mm: float, per_circle: float = 0.0, attempt: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Tetrahedra of a CAD solid (points mm); retries switch the 3D algorithm, since repeating a
+    deterministic failure cannot help."""
+    import gmsh
+
     try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.occ.importShapes(str(brep))
-        gmsh.model.occ.synchronize()
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size_mm)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", MIN_SIZE_FRACTION * size_mm)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", per_circle)
+        _gmsh_model(brep, size_mm, per_circle)
         gmsh.option.setNumber("Mesh.Algorithm3D", GMSH_ALGORITHMS[attempt % len(GMSH_ALGORITHMS)])
         gmsh.option.setNumber("Mesh.Optimize", 1)
         gmsh.model.mesh.generate(3)
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        types, _, nodes = gmsh.model.mesh.getElements(3)
-        if 4 not in list(types):
-            raise RuntimeError("gmsh produced no tetrahedra")
-        tet_nodes = np.asarray(nodes[list(types).index(4)], dtype=np.int64).reshape(-1, 4)
+        return _gmsh_elements(3, 4, 4)
     finally:
         gmsh.finalize()
-    index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-    index[tags.astype(np.int64)] = np.arange(len(tags))
-    return np.asarray(coords, dtype=np.float64).reshape(-1, 3), index[tet_nodes]
 
 
 def gmsh_face(brep: Path, size_mm: float, per_circle: float = 0.0, attempt: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """gmsh triangulation (points (n, 2) mm, triangles (m, 3)) of a planar face in a plane z = const,
-    sized like gmsh_brep; retries switch the 2D algorithm."""
+    """Triangulation (points (n, 2) mm, triangles (m, 3)) of a planar face in a plane z = const;
+    retries switch the 2D algorithm."""
     import gmsh
 
-    gmsh.initialize(interruptible=False)
     try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.occ.importShapes(str(brep))
-        gmsh.model.occ.synchronize()
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size_mm)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", MIN_SIZE_FRACTION * size_mm)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", per_circle)
+        _gmsh_model(brep, size_mm, per_circle)
         gmsh.option.setNumber("Mesh.Algorithm", GMSH_ALGORITHMS_2D[attempt % len(GMSH_ALGORITHMS_2D)])
         gmsh.model.mesh.generate(2)
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        types, _, nodes = gmsh.model.mesh.getElements(2)
-        if 2 not in list(types):
-            raise RuntimeError("gmsh produced no triangles")
-        tri_nodes = np.asarray(nodes[list(types).index(2)], dtype=np.int64).reshape(-1, 3)
+        points, triangles = _gmsh_elements(2, 2, 3)
+        return points[:, :2], triangles
     finally:
         gmsh.finalize()
-    index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-    index[tags.astype(np.int64)] = np.arange(len(tags))
-    return np.asarray(coords, dtype=np.float64).reshape(-1, 3)[:, :2], index[tri_nodes]
 
 
 def main(job_dir: str) -> None:
