@@ -35,7 +35,6 @@ class _CallbackSink:
         self.on_stage(*message)
 
 
-
 def run_serial(fn, tasks: list, on_stage: Callable[[Any, str], None], on_tick: Callable[[], None]) -> Iterator:
     """Tasks one after another in this process (jobs=1; exceptions propagate as raised)."""
     sink = _CallbackSink(on_stage)

@@ -7,7 +7,7 @@ model is linear (see seadesign/fea/torsion.py).
 
 Meshing is `seadesign.mesh.mesh_part`, the solve `seadesign.fea.loadcases.analyse` at 1 Nm per
 load case; a second P2 solve on a mesh COARSENING times coarser gives the discretization-error
-estimate of k (two-level Richardson with the observed order ~1 of these parts, see
+estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest order observed in
 benchmarks/fea_convergence.py).
 """
 
