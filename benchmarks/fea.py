@@ -49,7 +49,7 @@ def main() -> None:
         t = time.perf_counter()
         mesh = mesh_part(checked.part.solid, checked.part.interfaces, across, args.thickness_mm,
                          cache_dir=cache, backend=args.backend, elements_per_circle=per_circle,
-                         layers=st.mesh.scaled(1.0)["layers"] if args.backend == "gmsh" else 0)
+                         layers=st.mesh.mesh_part_options()["layers"] if args.backend == "gmsh" else 0)
         t_mesh = time.perf_counter() - t
     stages["tessellation / BREP export"] = mesh.info["geometry_s"]
     stages["tetrahedralization (child process)"] = mesh.info["tetrahedralize_s"]

@@ -30,7 +30,7 @@ from seadesign.study import load_study
 
 def k_at(st, part, width, refinement, backend, cache_dir) -> tuple[float, int, float]:
     t = time.perf_counter()
-    sizing = st.mesh.scaled(refinement)
+    sizing = st.mesh.scaled(refinement).mesh_part_options()
     if backend == "pytetwild":
         sizing.update(elements_per_circle=0.0, layers=0)
     mesh = mesh_part(part.solid, part.interfaces, beam_width_mm=width, cache_dir=cache_dir,

@@ -100,7 +100,7 @@ def tetrahedralize(study: Study, params: GeometryParams, checked, cache: Cache, 
     from seadesign.mesh import mesh_part
 
     return mesh_part(checked.part.solid, checked.part.interfaces, beam_width_mm=params.beam_thickness_mm,
-                     cache_dir=Path(cache.root) / "mesh", **study.mesh.scaled(1.0 / coarsening))
+                     cache_dir=Path(cache.root) / "mesh", **study.mesh.scaled(1.0 / coarsening).mesh_part_options())
 
 
 def unit_response(mesh, coarse_mesh, study: Study, settings: SolverSettings) -> UnitResponse:

@@ -74,11 +74,15 @@ class MeshSettings:
     elements_per_circle: float = 0.0  # gmsh: curved surfaces (bolt holes, fillets) get this many elements per turn
     layers: float = 0.0  # gmsh, prismatic parts: layers through the thickness (0: about one per element size)
 
-    def scaled(self, refinement: float) -> dict:
-        """mesh_part keyword arguments at `refinement` times this density (1: as given)."""
-        return {"elements_across_beam": self.elements_across_beam * refinement,
-                "elements_per_circle": self.elements_per_circle * refinement,
-                "layers": math.ceil(self.layers * refinement - 1e-9), "backend": self.backend}
+    def scaled(self, refinement: float) -> "MeshSettings":
+        """These settings at `refinement` times the density (layers rounded up)."""
+        return MeshSettings(self.elements_across_beam * refinement, self.backend,
+                            self.elements_per_circle * refinement, math.ceil(self.layers * refinement - 1e-9))
+
+    def mesh_part_options(self) -> dict:
+        """Keyword arguments of seadesign.mesh.mesh_part."""
+        return {"elements_across_beam": self.elements_across_beam, "elements_per_circle": self.elements_per_circle,
+                "layers": math.ceil(self.layers - 1e-9), "backend": self.backend}
 
 
 @dataclass(frozen=True)

@@ -17,10 +17,7 @@ from seadesign.sweep import run_sweep
 @pytest.mark.slow
 def test_displacement_falls_with_thickness_and_beam_count(tmp_path):
     study = load_study("wolfgang_knee")
-    m = study.mesh
-    coarse = dataclasses.replace(m, elements_across_beam=m.elements_across_beam / COARSENING,
-                                 elements_per_circle=m.elements_per_circle / COARSENING,
-                                 layers=max(2.0, m.layers / COARSENING))
+    coarse = study.mesh.scaled(1.0 / COARSENING)
     run = run_sweep(dataclasses.replace(study, mesh=coarse), tmp_path, cache=Cache(tmp_path / "cache"), quiet=True)
     ok = run.rows[run.rows["status"] == "ok"]
     assert len(ok) >= 15 and set(run.rows["status"]) <= {"ok", "invalid"}

@@ -96,7 +96,7 @@ def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs
         mesher = backend or st.mesh.backend
         per_circle = elements_per_circle if elements_per_circle is not None else (
             st.mesh.elements_per_circle if mesher == "gmsh" else 0.0)
-        layers = st.mesh.scaled(1.0)["layers"] if mesher == "gmsh" else 0
+        layers = st.mesh.mesh_part_options()["layers"] if mesher == "gmsh" else 0
     out_dir = out_dir or Path("exports") / (st.name if stl is None else stl.stem)
     results, _, _ = solve_part(
         geometry, interfaces,
