@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 DEFAULT_CACHE_DIR = Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
-TRACKED_PACKAGES = ("seadesign", "numpy", "scipy", "cadquery", "pytetwild", "pypardiso")
+TRACKED_PACKAGES = ("seadesign", "numpy", "scipy", "cadquery", "gmsh", "pytetwild", "mkl")
 
 
 def _plain(obj: Any) -> Any:

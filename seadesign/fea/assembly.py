@@ -1,11 +1,13 @@
-"""Global sparse matrices from element blocks (vectorised, chunked to bound memory).
+"""Global sparse matrices as the upper (block) triangle of a symmetric matrix.
 
-Assembly works on node pairs: the sparsity pattern is found once from the (m * nen^2) node
-pairs and the d x d blocks are summed with bincount, which is several times faster than
-converting the (m * (d nen)^2) scalar triplets.
+Assembly works on node pairs: every element contributes its nen(nen+1)/2 upper pair blocks,
+each mapped to global block rows (transposed where the global order flips, dropped where a
+node has no row, e.g. a held node), and equal (row, col) entries are summed with bincount.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -16,41 +18,99 @@ from seadesign.fea.elements import (
     lame,
     mass_reference,
     stiffness_blocks,
+    upper_pairs,
 )
 
-_CHUNK = 2048  # elements per vectorised block (small blocks stay in cache)
+_CHUNK = 8192  # elements per vectorised block
 
 
-def _assemble(elements: np.ndarray, n_nodes: int, blocks: np.ndarray) -> sp.csr_matrix:
-    """Sum node-pair blocks (m, nen, nen, d, d) into a CSR matrix with dofs ordered (node, component)."""
-    m, nen, d = blocks.shape[0], blocks.shape[1], blocks.shape[3]
-    rows = np.repeat(elements, nen, axis=1).ravel().astype(np.int64)
-    cols = np.tile(elements, (1, nen)).ravel().astype(np.int64)
-    keys, inv = np.unique(rows * n_nodes + cols, return_inverse=True)
-    data = blocks.reshape(m * nen * nen, d * d)
-    summed = np.stack([np.bincount(inv, weights=data[:, c], minlength=len(keys)) for c in range(d * d)], axis=1)
-    brow, bcol = keys // n_nodes, keys % n_nodes
-    indptr = np.searchsorted(brow, np.arange(n_nodes + 1))
-    bsr = sp.bsr_matrix((summed.reshape(-1, d, d), bcol, indptr), shape=(d * n_nodes, d * n_nodes))
-    return bsr.tocsr()
+@dataclass(frozen=True)
+class UpperBlocks:
+    """Entries (rows[i], cols[i]) with cols >= rows, sorted by row then column, of a symmetric
+    matrix with n block rows; values (k, d, d), diagonal blocks stored in full."""
+
+    rows: np.ndarray
+    cols: np.ndarray
+    values: np.ndarray
+    n: int
+
+    def matrix(self) -> sp.csr_matrix | sp.bsr_matrix:
+        """Scalar CSR (d = 1) or BSR (d > 1) upper triangle, as the factorization takes it."""
+        d = self.values.shape[1]
+        indptr = np.searchsorted(self.rows, np.arange(self.n + 1))
+        if d == 1:
+            return sp.csr_matrix((self.values[:, 0, 0], self.cols, indptr), shape=(self.n, self.n))
+        return sp.bsr_matrix((self.values, self.cols, indptr), shape=(d * self.n, d * self.n))
 
 
-def stiffness_matrix(mesh: ElementMesh, youngs_modulus_Pa: float, poisson_ratio: float) -> sp.csr_matrix:
-    """Linear-elastic stiffness matrix (N/m) of an isotropic material, full symmetric CSR."""
-    lam, mu = lame(youngs_modulus_Pa, poisson_ratio)
-    nen = mesh.elements.shape[1]
-    blocks = np.empty((len(mesh.elements), nen, nen, 3, 3))
-    for start in range(0, len(mesh.elements), _CHUNK):
-        el = mesh.elements[start : start + _CHUNK]
+def sum_pair_blocks(
+    elements: np.ndarray, order: int, blocks: np.ndarray, node_index: np.ndarray, n: int
+) -> UpperBlocks:
+    """Sum element pair blocks (P, m, d, d) over upper_pairs(order) (overwrites blocks);
+    node_index maps mesh nodes to block rows (-1: no row)."""
+    ia, ib = upper_pairs(order)
+    d = blocks.shape[-1]
+    r = node_index[elements[:, ia].T].ravel()
+    c = node_index[elements[:, ib].T].ravel()
+    v = blocks.reshape(-1, d, d)
+    keep = (r >= 0) & (c >= 0)
+    if not keep.all():
+        r, c, v = r[keep], c[keep], v[keep]
+    swap = r > c
+    v[swap] = v[swap].transpose(0, 2, 1)
+    keys, inv = np.unique(np.minimum(r, c).astype(np.int64) * n + np.maximum(r, c), return_inverse=True)
+    flat = v.reshape(len(v), d * d)
+    summed = np.stack([np.bincount(inv, weights=flat[:, j], minlength=len(keys)) for j in range(d * d)], axis=1)
+    return UpperBlocks(keys // n, keys % n, summed.reshape(-1, d, d), n)
+
+
+def _stiffness_pair_blocks(mesh: ElementMesh, elements: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    nen = elements.shape[1]
+    blocks = np.empty((nen * (nen + 1) // 2, len(elements), 3, 3))
+    for start in range(0, len(elements), _CHUNK):
+        el = elements[start : start + _CHUNK]
         grads, vol = barycentric_gradients(mesh.nodes_m, el)
-        blocks[start : start + len(el)] = stiffness_blocks(mesh.order, grads, vol, lam, mu)
-    return _assemble(mesh.elements, len(mesh.nodes_m), blocks)
+        blocks[:, start : start + len(el)] = stiffness_blocks(mesh.order, grads, vol, lam, mu)
+    return blocks
 
 
-def mass_matrix(mesh: ElementMesh) -> sp.csr_matrix:
+def stiffness_upper(
+    mesh: ElementMesh, youngs_modulus_Pa: float, poisson_ratio: float,
+    node_index: np.ndarray | None = None, n: int | None = None,
+) -> UpperBlocks:
+    """Linear-elastic stiffness (N/m) of an isotropic material in 3x3 node blocks; node_index
+    and n as in sum_pair_blocks (default: every node its own row)."""
+    if node_index is None:
+        node_index, n = np.arange(len(mesh.nodes_m)), len(mesh.nodes_m)
+    blocks = _stiffness_pair_blocks(mesh, mesh.elements, *lame(youngs_modulus_Pa, poisson_ratio))
+    return sum_pair_blocks(mesh.elements, mesh.order, blocks, node_index, n)
+
+
+def mass_upper(mesh: ElementMesh) -> UpperBlocks:
     """Scalar consistent mass matrix (m^3) used for L2 projection of nodal fields."""
-    ref = mass_reference(mesh.order)
+    ia, ib = upper_pairs(mesh.order)
     _, vol = barycentric_gradients(mesh.nodes_m, mesh.elements)
-    nen = mesh.elements.shape[1]
-    blocks = (vol[:, None, None] * ref[None]).reshape(-1, nen, nen, 1, 1)
-    return _assemble(mesh.elements, len(mesh.nodes_m), blocks)
+    blocks = (mass_reference(mesh.order)[ia, ib][:, None] * vol[None]).reshape(len(ia), len(vol), 1, 1)
+    n = len(mesh.nodes_m)
+    return sum_pair_blocks(mesh.elements, mesh.order, blocks, np.arange(n), n)
+
+
+def nodal_forces(
+    mesh: ElementMesh, u_m: np.ndarray, youngs_modulus_Pa: float, poisson_ratio: float, nodes: np.ndarray
+) -> np.ndarray:
+    """(N, 3) internal forces K u in N on the given nodes (zero elsewhere), from the elements
+    that touch them."""
+    touching = np.isin(mesh.elements, nodes).any(axis=1)
+    el = mesh.elements[touching]
+    k = _stiffness_pair_blocks(mesh, el, *lame(youngs_modulus_Pa, poisson_ratio))
+    ia, ib = upper_pairs(mesh.order)
+    na, nb = el[:, ia].T, el[:, ib].T
+    fa = np.einsum("pmij,pmj->pmi", k, u_m[nb])  # K_ab u_b at a
+    fb = np.einsum("pmij,pmi->pmj", k, u_m[na])  # K_ab^T u_a at b, for a != b
+    off = ia != ib
+    idx = np.concatenate([na.ravel(), nb[off].ravel()])
+    val = np.concatenate([fa.reshape(-1, 3), fb[off].reshape(-1, 3)])
+    f = np.stack([np.bincount(idx, weights=val[:, i], minlength=len(u_m)) for i in range(3)], axis=1)
+    out = np.zeros_like(f)
+    out[nodes] = f[nodes]
+    return out

@@ -100,29 +100,32 @@ def lame(youngs_modulus_Pa: float, poisson_ratio: float) -> tuple[float, float]:
     return lam, mu
 
 
+def upper_pairs(order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Local node pairs (a, b) with a <= b of an element: the blocks that define a symmetric matrix."""
+    return np.triu_indices(4 if order == 1 else 10)
+
+
 def stiffness_blocks(
     order: int, grads: np.ndarray, vol: np.ndarray, lam: float, mu: float
 ) -> np.ndarray:
-    """Element stiffness matrices as node-pair blocks (m, nen, nen, 3, 3) in N/m.
+    """Element stiffness blocks K_ab (P, m, 3, 3) in N/m for the upper_pairs (a, b), pair-major.
 
-    Exact for straight-sided elements: the degree-2(order-1) rule integrates the gradient
-    products exactly.
+    Shape-function gradients are combinations of the barycentric gradients G_k, so
+    K_ab = sum_kl C[ab, kl] E_kl with C[ab, kl] = int dN_a/dlam_k dN_b/dlam_l (exact with the
+    degree-2(order-1) rule on straight-sided elements) and the per-element 3x3 matrices
+    E_kl = vol (lam G_k G_l^T + mu G_l G_k^T + mu (G_k . G_l) I): one matrix product per chunk.
     """
     qlam, qw = quadrature(2 * (order - 1))
     dlam = shape_dlam(order, qlam)  # (q, nen, 4)
-    g = np.einsum("qak,mkc->mcaq", dlam, grads) * np.sqrt(qw)  # (m, 3, nen, q), weighted
-    m, _, nen, _ = g.shape
-    # p[:, i, j, a, b] = sum_q w dN_a/dx_i dN_b/dx_j
-    p = np.matmul(g[:, :, None], g[:, None].transpose(0, 1, 2, 4, 3))
-    s = p[:, 0, 0] + p[:, 1, 1] + p[:, 2, 2]
-    k = np.empty((m, nen, nen, 3, 3))
-    for i in range(3):
-        for j in range(3):
-            blk = lam * p[:, i, j] + mu * p[:, i, j].transpose(0, 2, 1)
-            if i == j:
-                blk += mu * s
-            k[:, :, :, i, j] = blk * vol[:, None, None]
-    return k
+    ia, ib = upper_pairs(order)
+    c = np.einsum("q,qak,qbl->abkl", qw, dlam, dlam)[ia, ib].reshape(len(ia), 16)
+    outer = grads[:, :, None, :, None] * grads[:, None, :, None, :]  # (m, k, l, i, j) = G_ki G_lj
+    e = lam * outer + mu * outer.transpose(0, 2, 1, 3, 4)  # mu G_kj G_li = mu (G_l G_k^T)_ij
+    dots = np.einsum("mki,mli->mkl", grads, grads)
+    e[..., [0, 1, 2], [0, 1, 2]] += mu * dots[..., None]
+    e *= vol[:, None, None, None, None]
+    e = e.transpose(1, 2, 0, 3, 4).reshape(16, -1)  # (kl, m * 9)
+    return (c @ e).reshape(len(ia), len(vol), 3, 3)
 
 
 def mass_reference(order: int) -> np.ndarray:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from seadesign.fea.assembly import mass_matrix
+from seadesign.fea.assembly import mass_upper
 from seadesign.fea.elements import (
     ElementMesh,
     barycentric_gradients,
@@ -50,7 +50,10 @@ def project_to_nodes(emesh: ElementMesh, vertex_values: np.ndarray) -> np.ndarra
         [np.bincount(emesh.elements.ravel(), weights=local[..., c].ravel(), minlength=n) for c in range(local.shape[2])],
         axis=1,
     )
-    return SPDFactorization(mass_matrix(emesh)).solve(rhs)
+    fact = SPDFactorization(mass_upper(emesh).matrix())
+    x = fact.solve(rhs)
+    fact.close()
+    return x
 
 
 def invariants(voigt_Pa: np.ndarray) -> dict[str, np.ndarray]:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from seadesign.fea.assembly import stiffness_matrix
+from seadesign.fea.assembly import nodal_forces, stiffness_upper
 from seadesign.fea.couplings import couple
 from seadesign.fea.elements import ElementMesh, element_mesh, midside_nodes
 from seadesign.fea.linsolve import SPDFactorization
@@ -27,7 +27,7 @@ class UnitTorsion:
 
     displacement_m: (N, 3) nodal displacement in m/Nm; hub_motion: (6,) reference point
     translation (m/Nm) and rotation (rad/Nm); nodal_force_N: (N, 3) internal nodal forces K u in
-    N/Nm (the coupling / support reactions on coupled and held nodes, ~0 elsewhere).
+    N/Nm on the coupled and held nodes (the coupling and support reactions; zero elsewhere).
     """
 
     emesh: ElementMesh
@@ -86,30 +86,28 @@ def solve_unit_torsion(
     ref_m = np.array([0.0, 0.0, 0.5 * (z.min() + z.max()) * MM])
     t1 = time.perf_counter()
 
-    k = stiffness_matrix(emesh, youngs_modulus_Pa, poisson_ratio)
     cpl = couple(emesh.nodes_m, hub_nodes, ring_nodes, ref_m)
-    tt = cpl.transform
-    kr = (tt.T @ k @ tt).tocsr()
+    k = cpl.condense(stiffness_upper(emesh, youngs_modulus_Pa, poisson_ratio, cpl.node_index, cpl.n_rows))
     t2 = time.perf_counter()
 
-    fact = SPDFactorization(kr, backend=linear_solver)
+    fact = SPDFactorization(k.matrix(), backend=linear_solver)
     t3 = time.perf_counter()
 
-    rhs = np.zeros(kr.shape[0])
+    rhs = np.zeros(3 * k.n)
     rhs[cpl.ref_dofs[5]] = 1.0  # 1 Nm about +z
     q = fact.solve(rhs)
     fact.close()
-    u = tt @ q
-    f = k @ u
+    u = cpl.displacements(q)
+    f = nodal_forces(emesh, u, youngs_modulus_Pa, poisson_ratio, np.union1d(hub_nodes, ring_nodes))
     t4 = time.perf_counter()
     return UnitTorsion(
         emesh=emesh,
-        displacement_m=u.reshape(-1, 3),
+        displacement_m=u,
         hub_motion=q[cpl.ref_dofs],
-        nodal_force_N=f.reshape(-1, 3),
+        nodal_force_N=f,
         ref_m=ref_m,
         hub_groups=hub_groups,
         ring_nodes=ring_nodes,
-        n_dofs=int(kr.shape[0]),
+        n_dofs=3 * k.n,
         timings_s={"setup": t1 - t0, "assembly": t2 - t1, "factorization": t3 - t2, "solve": t4 - t3},
     )

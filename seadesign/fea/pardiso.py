@@ -1,0 +1,103 @@
+"""A small ctypes binding to MKL PARDISO (libmkl_rt from the `mkl` wheel) for symmetric
+positive-definite matrices stored as their upper triangle, in CSR or in 3x3-block BSR.
+
+Block storage matters: PARDISO then orders the node graph, nine times smaller than the
+scalar one (on a 374k-dof spring: analysis 1.0 s instead of 4.1 s, factorization 4.0 s
+instead of 5.7 s).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import glob
+import os
+import sys
+from functools import cache
+
+import numpy as np
+import scipy.sparse as sp
+
+from seadesign.errors import SolverError
+
+_SPD = 2  # PARDISO mtype: real symmetric positive definite
+_ERRORS = {
+    -2: "not enough memory",
+    -3: "reordering failed",
+    -4: "zero or negative pivot: the matrix is not positive definite (under-constrained structure?)",
+    -8: "32-bit integer overflow: the problem is too large",
+}
+_P = ctypes.POINTER
+_I32 = ctypes.c_int32
+
+
+@cache
+def _library() -> ctypes.CDLL:
+    """libmkl_rt: next to this interpreter (pip's `mkl` wheel), else on the loader path."""
+    names = ["mkl_rt.*.dll", "libmkl_rt.so*", "libmkl_rt*.dylib"]
+    roots = [os.path.join(sys.prefix, "lib"), os.path.join(sys.prefix, "Library", "bin")]
+    found = sorted(p for r in roots for n in names for p in glob.glob(os.path.join(r, n)))
+    for path in found + ["libmkl_rt.so.3", "libmkl_rt.so.2", "libmkl_rt.so"]:
+        try:
+            lib = ctypes.CDLL(path)
+        except OSError:
+            continue
+        lib.pardiso.restype = None
+        lib.pardiso.argtypes = [_P(ctypes.c_int64)] + [_P(_I32)] * 5 + [ctypes.c_void_p, _P(_I32), _P(_I32),
+                                _P(_I32), _P(_I32), _P(_I32), _P(_I32), ctypes.c_void_p, ctypes.c_void_p, _P(_I32)]
+        lib.pardisoinit.restype = None
+        lib.pardisoinit.argtypes = [_P(ctypes.c_int64), _P(_I32), _P(_I32)]
+        return lib
+    raise SolverError("MKL PARDISO not found: `pip install mkl`, or choose linear_solver='scipy'")
+
+
+class Pardiso:
+    """Cholesky factorization of an SPD matrix given as its upper triangle: scalar CSR, or BSR
+    whose block entries hold col >= row with full diagonal blocks."""
+
+    def __init__(self, upper: sp.csr_matrix | sp.bsr_matrix) -> None:
+        self._lib = _library()
+        self.n = upper.shape[0]
+        block = upper.blocksize[0] if sp.issparse(upper) and upper.format == "bsr" else 1
+        upper.sort_indices()
+        self._data = np.ascontiguousarray(upper.data, dtype=np.float64)
+        self._ia = np.ascontiguousarray(upper.indptr, dtype=np.int32)
+        self._ja = np.ascontiguousarray(upper.indices, dtype=np.int32)
+        self._rows = self.n // block
+        self._pt = np.zeros(64, dtype=np.int64)
+        self._iparm = np.zeros(64, dtype=np.int32)
+        self._lib.pardisoinit(self._pt.ctypes.data_as(_P(ctypes.c_int64)), ctypes.byref(_I32(_SPD)),
+                              self._iparm.ctypes.data_as(_P(_I32)))
+        self._iparm[34] = 1  # zero-based indices
+        self._iparm[36] = block if block > 1 else 0
+        self._alive = True
+        self._call(12, np.zeros(self.n))
+
+    def _call(self, phase: int, b: np.ndarray) -> np.ndarray:
+        x = np.zeros_like(b)
+        err = _I32(0)
+        nrhs = 1 if b.ndim == 1 else b.shape[1]
+        self._lib.pardiso(
+            self._pt.ctypes.data_as(_P(ctypes.c_int64)), ctypes.byref(_I32(1)), ctypes.byref(_I32(1)),
+            ctypes.byref(_I32(_SPD)), ctypes.byref(_I32(phase)), ctypes.byref(_I32(self._rows)),
+            self._data.ctypes.data, self._ia.ctypes.data_as(_P(_I32)), self._ja.ctypes.data_as(_P(_I32)),
+            None, ctypes.byref(_I32(nrhs)), self._iparm.ctypes.data_as(_P(_I32)), ctypes.byref(_I32(0)),
+            b.ctypes.data, x.ctypes.data, ctypes.byref(err),
+        )
+        if err.value != 0:
+            self.close()
+            raise SolverError(f"PARDISO failed in phase {phase}: {_ERRORS.get(err.value, f'error {err.value}')}")
+        return x
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """Solution for one (n,) or several (n, r) right-hand sides."""
+        b = np.asfortranarray(b, dtype=np.float64)  # PARDISO reads columns
+        return np.ascontiguousarray(self._call(33, b))
+
+    def close(self) -> None:
+        """Release the factorization (MKL holds it outside Python's heap)."""
+        if self._alive:
+            self._alive = False
+            self._call(-1, np.zeros(self.n))
+
+    def __del__(self) -> None:
+        self.close()

@@ -1,0 +1,127 @@
+"""Block-upper assembly, rigid condensation and the PARDISO binding against independent
+references: scikit-fem's assembler, an explicit T^T K T, the patch test and SciPy's solver."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers_annulus import annulus_mesh
+from skfem import Basis, ElementTetP1, ElementTetP2, ElementVector, MeshTet, asm
+from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+from seadesign.errors import SolverError
+from seadesign.fea.assembly import mass_upper, nodal_forces, stiffness_upper
+from seadesign.fea.couplings import couple
+from seadesign.fea.elements import element_mesh, midside_nodes
+from seadesign.fea.linsolve import SPDFactorization, full_from_upper
+
+E, NU = 12e6, 0.48
+
+
+@pytest.fixture(scope="module")
+def small():
+    m = annulus_mesh(5.0, 12.0, 3.0, n_r=2, n_theta=12, n_z=1)
+    return m.points_mm * 1e-3, m.tets
+
+
+def _skfem_permutation(points, tets, emesh):
+    """Our dof index of each scikit-fem dof (vector P1/P2, 3 components per node)."""
+    mesh = MeshTet(points.T.copy(), tets.T.copy())
+    basis = Basis(mesh, ElementVector(ElementTetP2() if emesh.order == 2 else ElementTetP1()))
+    ours = np.empty(basis.N, dtype=np.int64)
+    for c in range(3):
+        ours[basis.nodal_dofs[c]] = 3 * np.arange(mesh.nvertices) + c
+        if emesh.order == 2:
+            mid = midside_nodes(emesh, mesh.edges[0], mesh.edges[1])
+            ours[basis.edge_dofs[c]] = 3 * mid + c
+    return basis, ours
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_stiffness_equals_scikit_fem(small, order):
+    points, tets = small
+    emesh = element_mesh(points, tets, order)
+    ours = full_from_upper(stiffness_upper(emesh, E, NU).matrix()).toarray()
+    basis, perm = _skfem_permutation(points, tets, emesh)
+    ref = asm(linear_elasticity(*lame_parameters(E, NU)), basis).toarray()
+    mine = ours[np.ix_(perm, perm)]
+    assert np.abs(mine - ref).max() < 1e-9 * np.abs(ref).max()
+
+
+def test_patch_test_energy_and_interior_forces(small):
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    k = full_from_upper(stiffness_upper(emesh, E, NU).matrix())
+    grad = np.array([[1.0, 0.3, -0.2], [0.1, -0.5, 0.4], [0.2, 0.0, 0.7]]) * 1e-3
+    u = emesh.nodes_m @ grad.T
+    eps = 0.5 * (grad + grad.T)
+    lam, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
+    volume = np.pi * (0.012**2 - 0.005**2) * 0.003 * (np.sin(2 * np.pi / 12) * 12 / (2 * np.pi))  # 12-gon annulus
+    energy = volume * (lam * np.trace(eps) ** 2 + 2 * mu * np.sum(eps * eps))
+    assert u.ravel() @ (k @ u.ravel()) == pytest.approx(energy, rel=1e-9)
+    r = np.hypot(*emesh.nodes_m[:, :2].T)
+    z = emesh.nodes_m[:, 2]  # chord midpoints of the outer 12-gon lie at r = 11.6 mm
+    interior = (r > 0.0051) & (r < 0.011) & (z > 1e-6) & (z < 0.003 - 1e-6)
+    f = (k @ u.ravel()).reshape(-1, 3)
+    assert interior.any() and np.abs(f[interior]).max() < 1e-9 * np.abs(f).max()
+
+
+def test_condensation_and_solve_match_explicit_transform(small):
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    r = np.hypot(*emesh.nodes_m[:, :2].T)
+    hub, ring = np.flatnonzero(r < 0.0051), np.flatnonzero(r > 0.0119)
+    ref = np.array([0.0, 0.0, 0.0015])
+    cpl = couple(emesh.nodes_m, hub, ring, ref)
+    reduced = full_from_upper(cpl.condense(stiffness_upper(emesh, E, NU, cpl.node_index, cpl.n_rows)).matrix())
+
+    # explicit u = T q over all nodes: free dofs identity, hub nodes t + w x (x - ref), ring held
+    n = len(emesh.nodes_m)
+    free = np.setdiff1d(np.arange(n), np.union1d(hub, ring))
+    t = np.zeros((3 * n, 3 * len(free) + 6))
+    for i, node in enumerate(free):
+        t[3 * node : 3 * node + 3, 3 * i : 3 * i + 3] = np.eye(3)
+    for node in hub:
+        d = emesh.nodes_m[node] - ref
+        t[3 * node : 3 * node + 3, -6:-3] = np.eye(3)
+        t[3 * node : 3 * node + 3, -3:] = -np.array([[0, -d[2], d[1]], [d[2], 0, -d[0]], [-d[1], d[0], 0]])
+    k_full = full_from_upper(stiffness_upper(emesh, E, NU).matrix()).toarray()
+    explicit = t.T @ k_full @ t
+    assert np.abs(reduced.toarray() - explicit).max() < 1e-9 * np.abs(explicit).max()
+
+    rhs = np.zeros(reduced.shape[0])
+    rhs[cpl.ref_dofs[5]] = 1.0
+    expected = np.linalg.solve(explicit, rhs)
+    upper = cpl.condense(stiffness_upper(emesh, E, NU, cpl.node_index, cpl.n_rows)).matrix()
+    for backend in ("pardiso", "scipy"):
+        fact = SPDFactorization(upper, backend=backend)
+        q = fact.solve(rhs)
+        fact.close()
+        assert np.abs(q - expected).max() < 1e-8 * np.abs(expected).max()
+
+    u = cpl.displacements(expected)
+    assert np.allclose(u.ravel(), t @ expected)
+    f = nodal_forces(emesh, u, E, NU, np.union1d(hub, ring))
+    full = (k_full @ u.ravel()).reshape(-1, 3)
+    assert np.allclose(f[hub], full[hub], atol=1e-9) and np.allclose(f[ring], full[ring], atol=1e-9)
+    torque = lambda nodes: np.sum(emesh.nodes_m[nodes, 0] * f[nodes, 1] - emesh.nodes_m[nodes, 1] * f[nodes, 0])  # noqa: E731
+    assert torque(hub) == pytest.approx(1.0, rel=1e-9) and torque(ring) == pytest.approx(-1.0, rel=1e-9)
+
+
+def test_mass_matrix_integrates_volume(small):
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    m = full_from_upper(mass_upper(emesh).matrix())
+    one = np.ones(m.shape[0])
+    volume = np.sum(np.abs(np.linalg.det(points[tets[:, 1:]] - points[tets[:, :1]]))) / 6
+    assert one @ (m @ one) == pytest.approx(volume, rel=1e-12)
+
+
+def test_pardiso_refuses_a_matrix_that_is_not_positive_definite(small):
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    r = np.hypot(*emesh.nodes_m[:, :2].T)
+    cpl = couple(emesh.nodes_m, np.flatnonzero(r < 0.0051), np.flatnonzero(r > 0.0119), np.zeros(3))
+    k = cpl.condense(stiffness_upper(emesh, E, NU, cpl.node_index, cpl.n_rows)).matrix()
+    with pytest.raises(SolverError, match="not positive definite"):
+        SPDFactorization(-k)
