@@ -3,7 +3,8 @@
 Trains each model on the real recordings (../shared/data/deepsea, cleaned by the data module)
 when present, else on synthetic linear-spring recordings, and reports training throughput
 (samples/s), wall time to convergence (early stop), and the single-sample inference latency of
-the exported model (TorchScript frozen, and the NumPy path), median over many calls.
+the exported model (TorchScript frozen: forward on a ready input vector and the online step();
+and the NumPy path), median over many calls.
 
     python benchmarks/train.py [--models mlp,siamese,history,residual] [--calls 5000] [--threads 2]
 """
@@ -59,7 +60,8 @@ def main() -> None:
     print(f"data: {source}; task thesis, modalities velocity_effort, positive; split time_blocks; "
           f"training threads {args.threads}, device {'cuda' if torch.cuda.is_available() else 'cpu'}")
     header = (f"{'model':<10} {'samples':>8} {'batch':>6} {'epochs':>7} {'best':>5} {'stop':>10} {'wall_s':>7} "
-              f"{'samples_per_s':>14} {'val_mse_rad2':>13} {'ts_latency_us':>14} {'np_latency_us':>14}")
+              f"{'samples_per_s':>14} {'val_mse_rad2':>13} {'ts_latency_us':>14} {'step_latency_us':>16} "
+              f"{'np_latency_us':>14}")
     print(header)
     for model in args.models.split(","):
         spec = DatasetSpec("thesis", "velocity_effort", 3 if model == "history" else 0, True)
@@ -67,7 +69,8 @@ def main() -> None:
         cfg = TrainConfig(model=model, threads=args.threads, max_seconds=args.max_seconds)
         res = fit(ds, time_block_split(ds), K, cfg)
         with tempfile.TemporaryDirectory() as tmp:
-            bundle = export_bundle(res.net, {"inputs": input_list(ds.feature_names, model == "siamese")}, tmp)
+            meta = {"inputs": input_list(ds.feature_names, model == "siamese"), "dataset": spec.to_dict()}
+            bundle = export_bundle(res.net, meta, tmp)
             ts, npc = load_torchscript(bundle), load_numpy(bundle)
             x = np.concatenate([ds.X[0], ds.X_next[0]]) if model == "siamese" else ds.X[0]
             before = torch.get_num_threads()
@@ -75,13 +78,16 @@ def main() -> None:
             with torch.inference_mode():
                 xt = torch.as_tensor(x[None, :], dtype=torch.float32)
                 ts_us = _latency_us(ts, xt, args.calls)
+                m = torch.zeros(len(ts.measured_names()))
+                step_us = _latency_us(lambda v: ts.step(1, 0.5, v), m, args.calls)
             torch.set_num_threads(before)
             np_us = _latency_us(npc, x.astype(np.float32), args.calls)
         s = res.summary()
         print(f"{model:<10} {len(ds):>8} {cfg.batch_size:>6} {s['epochs_run']:>7} {s['best_epoch']:>5} "
               f"{s['stopped']:>10} {s['wall_s']:>7.1f} {s['samples_per_s']:>14.0f} {s['best_val_mse_rad2']:>13.3g} "
-              f"{ts_us:>14.1f} {np_us:>14.1f}")
-    print("latency: median of single-sample calls, 1 torch thread; samples_per_s counts training samples "
+              f"{ts_us:>14.1f} {step_us:>16.1f} {np_us:>14.1f}")
+    print("latency: median of single-sample calls, 1 torch thread (step: the online TorchScript path with "
+          "history and mirroring); samples_per_s counts training samples "
           "seen per second of wall time (incl. validation each epoch). Other processes share this CPU.")
 
 

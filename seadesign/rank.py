@@ -161,3 +161,28 @@ def explain(t: pd.DataFrame, best: int, second: int | None, feasible: bool) -> s
         text += (f" Its rotation under load ({b['max_rotation_rad']:.2f} rad) exceeds the small-deflection limit "
                  f"({b['small_deflection_limit_rad']:g} rad), so its linear results are an extrapolation.")
     return text
+
+
+def standing_verdict(ranked: pd.DataFrame, candidate: str, study: Study) -> str:
+    """Whether `candidate` carries the robot's standing load in `ranked` (deflection vs the limit, deg)."""
+    row = ranked.loc[ranked["candidate"] == candidate].iloc[0]
+    limit = study.ranking.max_standing_deflection_deg
+    deg = float(row["standing_deflection_deg"])
+    verdict = "carries" if deg < limit else "does NOT carry"
+    return (f"{candidate}: k {row['k_Nm_per_rad']:.4g} Nm/rad, standing deflection {deg:.3g} deg under "
+            f"{row['standing_knee_torque_Nm']:.3g} Nm (limit {limit:g} deg): {verdict} the standing load")
+
+
+def calibration_summary(base: pd.DataFrame, base_choice: Choice, calibrated: pd.DataFrame, choice: Choice,
+                        study: Study) -> str:
+    """Lines comparing the choice before and after calibration, each judged with the calibrated material."""
+    if base_choice.index is None or choice.index is None:
+        return "calibration: no candidate was solved, nothing to compare"
+    before, after = base.loc[base_choice.index, "candidate"], calibrated.loc[choice.index, "candidate"]
+    lines = [f"calibration: choice {'unchanged' if before == after else 'changes'}: {before} -> {after}",
+             "  uncalibrated choice, calibrated material: " + standing_verdict(calibrated, before, study)]
+    if after != before:
+        lines.append("  calibrated choice: " + standing_verdict(calibrated, after, study))
+    if not choice.feasible:
+        lines.append("  no candidate meets every constraint with the calibrated material; see the report")
+    return "\n".join(lines)

@@ -154,7 +154,7 @@ def test_torchscript_and_numpy_agree(recs, model, tmp_path):
     res = fit(ds, time_block_split(ds), K, TrainConfig(model=model, max_epochs=3, patience=3))
     siamese = model == "siamese"
     names = input_list(ds.feature_names, siamese)
-    bundle = export_bundle(res.net, {"inputs": names, "model": model}, tmp_path / model)
+    bundle = export_bundle(res.net, {"inputs": names, "model": model, "dataset": spec.to_dict()}, tmp_path / model)
     ts, npc = load_torchscript(bundle), load_numpy(bundle)
     X = np.concatenate([ds.X, ds.X_next], axis=1) if siamese else ds.X
     X = X.astype(np.float32)
@@ -167,3 +167,34 @@ def test_torchscript_and_numpy_agree(recs, model, tmp_path):
     assert abs(npc(X[7]) - a[7]) < 2e-6
     assert ts.input_names() == names
     assert ts.input_units()[0] == "rad" and "Nm" in ts.input_units()
+
+
+@pytest.mark.parametrize("model", ["history", "siamese"])
+def test_torchscript_step_runs_history_and_mirroring_like_the_online_builder(recs, model, tmp_path):
+    """The exported step() (history window and right-knee mirroring inside the TorchScript
+    module) gives the NumPy corrector driven through FeatureBuilder, for both knees."""
+    from seadesign.corrector.runtime import NetCorrector
+
+    spec = DatasetSpec(modalities="velocity_effort", history=3 if model == "history" else 0, positive=True)
+    ds = build_dataset(recs[:1], spec)
+    res = fit(ds, time_block_split(ds), K, TrainConfig(model=model, max_epochs=3, patience=3))
+    meta = {"inputs": input_list(ds.feature_names, model == "siamese"), "model": model, "dataset": spec.to_dict()}
+    bundle = export_bundle(res.net, meta, tmp_path / model)
+    ts = load_torchscript(bundle)
+    online = NetCorrector(load_numpy(bundle), spec, model)
+    rec = recs[1]
+    names = ts.measured_names()
+    assert names[: len(channels(spec.modalities))] == list(channels(spec.modalities))
+    for i in range(40):
+        for k, knee in enumerate(("left", "right")):
+            measured = {c: float(rec.knees[knee][c][i]) for c in rec.knees[knee]}
+            target = float(rec.knees[knee]["hall_pos_rad"][i + 1])
+            ref = online.command(knee, target, measured, 0.01)
+            got = ts.step(k, target, torch.tensor([measured[c] for c in names], dtype=torch.float64))
+            assert got == pytest.approx(ref, abs=2e-5), (i, knee)
+    ts.reset()
+    online.reset()
+    m0 = {c: float(rec.knees["right"][c][5]) for c in rec.knees["right"]}
+    assert ts.step(1, 0.3, torch.tensor([m0[c] for c in names])) == pytest.approx(online.command("right", 0.3, m0, 0.01), abs=2e-5)
+    with pytest.raises(torch.jit.Error, match="knee must be"):
+        ts.step(2, 0.3, torch.tensor([m0[c] for c in names]))

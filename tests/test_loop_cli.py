@@ -59,6 +59,14 @@ def test_thesis_worked_example(tmp_path, spring_file):
     assert cal["stiffness_scale"] == pytest.approx(K_MEASURED_NM_PER_RAD / K_FEA_NM_PER_RAD, rel=0.01)
     assert cal["parameters"]["dead_band"]["width"]["value"] == pytest.approx(0.03, rel=0.1)
     assert cal["held_out_rmse_after"] < cal["held_out_rmse_before"] / 100
+    # the scale is relative to the thesis FEA's material (generic TPU), so the sweep takes the fitted modulus
+    from seadesign.cli.sweep_cmds import apply_calibration
+    from seadesign.materials import load_material
+    from seadesign.study import load_study
+
+    study, _ = apply_calibration(load_study("wolfgang_knee"), tmp_path / "thesis_calibration.json")
+    e_thesis = load_material("generic_tpu").youngs_modulus_Pa
+    assert study.material.youngs_modulus_Pa == pytest.approx(e_thesis * K_MEASURED_NM_PER_RAD / K_FEA_NM_PER_RAD, rel=0.01)
 
 
 @pytest.mark.shared

@@ -173,7 +173,42 @@ def test_calibration_scales_the_modulus(tmp_path):
     (tmp_path / "c.json").write_text(json.dumps({"youngs_modulus_Pa": 6e6}))
     c, _ = apply_calibration(s, tmp_path / "c.json")
     assert c.material.youngs_modulus_Pa == pytest.approx(6e6)
+    # explain's file: the scale was fitted against another material, so its fitted modulus wins
+    (tmp_path / "e.json").write_text(json.dumps({"stiffness_scale": 0.02, "youngs_modulus_model_Pa": 1.47e8,
+                                                 "youngs_modulus_fitted_Pa": 2.94e6}))
+    c, _ = apply_calibration(s, tmp_path / "e.json")
+    assert c.material.youngs_modulus_Pa == pytest.approx(2.94e6)
+    (tmp_path / "s.json").write_text(json.dumps({"stiffness_scale": 0.5}))
+    c, _ = apply_calibration(s, tmp_path / "s.json")
+    assert c.material.youngs_modulus_Pa == pytest.approx(0.5 * s.material.youngs_modulus_Pa)
     (tmp_path / "bad.json").write_text(json.dumps({"stiffness_scale": -1}))
     with pytest.raises(ConfigError, match="stiffness_scale"):
         apply_calibration(s, tmp_path / "bad.json")
-    assert np.isfinite(s.material.youngs_modulus_Pa)
+    (tmp_path / "none.json").write_text(json.dumps({"k": 3}))
+    with pytest.raises(ConfigError, match="youngs_modulus_fitted_Pa"):
+        apply_calibration(s, tmp_path / "none.json")
+
+
+def test_calibrated_sweep_reranks_and_judges_the_standing_load(tiny, tmp_path):
+    """A softer calibrated material: k and the standing deflection scale exactly with E (linear
+    elasticity), outputs go to <study>-calibrated/, and the verdict follows the study's limit."""
+    study_path, cache_dir, out = tiny
+    s = load_study(study_path)
+    base = pd.read_parquet(out / "tiny" / "results.parquet")
+    k0 = float(base.loc[base["status"] == "ok", "k_Nm_per_rad"].iloc[0])
+    limit = s.ranking.max_standing_deflection_deg
+    # a modulus that puts the standing deflection at twice the limit
+    deg0 = math.degrees(s.robot.standing_knee_torque_Nm / k0)
+    e_cal = s.material.youngs_modulus_Pa * deg0 / (2 * limit)
+    cal = tmp_path / "cal.json"
+    cal.write_text(json.dumps({"stiffness_scale": 0.1, "youngs_modulus_fitted_Pa": e_cal}))
+    result = CliRunner().invoke(main, ["sweep", str(study_path), "--jobs", "1", "--quiet", "--out", str(out),
+                                       "--cache-dir", str(cache_dir), "--calibration", str(cal)])
+    assert result.exit_code == 0, result.output
+    r = pd.read_parquet(out / "tiny-calibrated" / "results.parquet")
+    k1 = float(r.loc[r["status"] == "ok", "k_Nm_per_rad"].iloc[0])
+    assert k1 / k0 == pytest.approx(e_cal / s.material.youngs_modulus_Pa, rel=1e-9)
+    assert float(r.loc[r["status"] == "ok", "standing_deflection_deg"].iloc[0]) == pytest.approx(2 * limit, rel=1e-9)
+    assert "calibration: choice unchanged: 3 beams x 8 mm -> 3 beams x 8 mm" in result.output
+    assert "does NOT carry the standing load" in result.output
+    assert pd.read_parquet(out / "tiny" / "results.parquet")["k_Nm_per_rad"].equals(base["k_Nm_per_rad"])

@@ -14,22 +14,27 @@ from seadesign.errors import ConfigError
 from seadesign.study import DEFAULT_STUDY, Study, load_study
 
 
+CALIBRATION_KEYS = ("youngs_modulus_fitted_Pa", "youngs_modulus_Pa", "stiffness_scale")
+
+
 def apply_calibration(study: Study, path: Path) -> tuple[Study, str]:
-    """The study with its material modulus replaced from a calibration JSON that holds either
-    `stiffness_scale` (multiplies E, > 0) or `youngs_modulus_Pa` (replaces E, > 0)."""
+    """The study with its Young's modulus from a calibration JSON, first key found of:
+    `youngs_modulus_fitted_Pa` (written by `explain`: the model material's E times the fitted
+    stiffness scale) or `youngs_modulus_Pa` replace E (Pa); a bare `stiffness_scale` multiplies
+    the study's E (right only when it was fitted against this study's material)."""
     try:
         data = json.loads(Path(path).read_text())
     except (OSError, json.JSONDecodeError) as exc:
         raise ConfigError(f"--calibration {path}: cannot be read as JSON ({exc})") from None
-    keys = [k for k in ("stiffness_scale", "youngs_modulus_Pa") if isinstance(data, dict) and k in data]
-    if len(keys) != 1:
-        raise ConfigError(f"--calibration {path}: needs exactly one of 'stiffness_scale' (factor on E) or "
-                          f"'youngs_modulus_Pa' (Pa), found {keys or 'neither'}")
-    value = data[keys[0]]
+    key = next((k for k in CALIBRATION_KEYS if isinstance(data, dict) and k in data), None)
+    if key is None:
+        raise ConfigError(f"--calibration {path}: needs one of {', '.join(CALIBRATION_KEYS)} "
+                          "(moduli in Pa, the scale a factor on E); `seadesign explain --spring` writes such a file")
+    value = data[key]
     if not isinstance(value, (int, float)) or isinstance(value, bool) or not value > 0:
-        raise ConfigError(f"--calibration {path}: '{keys[0]}' must be a positive number, got {value!r}")
-    scale = value if keys[0] == "stiffness_scale" else value / study.material.youngs_modulus_Pa
-    note = f"calibrated from {Path(path).name}: E x {scale:.4g}"
+        raise ConfigError(f"--calibration {path}: '{key}' must be a positive number, got {value!r}")
+    scale = value if key == "stiffness_scale" else value / study.material.youngs_modulus_Pa
+    note = f"calibrated from {Path(path).name} ({key} = {value:.4g}): E = {study.material.youngs_modulus_Pa * scale:.4g} Pa"
     return dataclasses.replace(study, material=study.material.scaled(scale, note)), note
 
 
@@ -46,8 +51,9 @@ def apply_calibration(study: Study, path: Path) -> tuple[Study, str]:
 @click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=Path("exports"),
               show_default=True, help="Output root (directory); files go to OUT/<study>/.")
 @click.option("--calibration", type=click.Path(dir_okay=False, exists=True, path_type=Path), default=None,
-              help="JSON with 'stiffness_scale' (factor, -) or 'youngs_modulus_Pa' (Pa) replacing the material's "
-                   "Young's modulus; the choice with and without it is printed.")
+              help="Calibration JSON (from `seadesign explain --spring`) whose fitted modulus replaces the material's "
+                   "Young's modulus; outputs go to OUT/<study>-calibrated/ and the choice with and without it, "
+                   "and whether each carries the standing load, is printed.")
 @click.option("--cache-dir", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Stage cache directory; default $SEADESIGN_CACHE or ~/.cache/seadesign.")
 @click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0), default=0.01, show_default=True,
@@ -61,7 +67,7 @@ def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: s
     named, otherwise SI (N, Nm, rad, Pa).
     """
     from seadesign.cache import DEFAULT_CACHE_DIR, Cache
-    from seadesign.rank import rank
+    from seadesign.rank import calibration_summary, rank
     from seadesign.report import write_outputs
     from seadesign.stages import SolverSettings
     from seadesign.sweep import run_sweep, sweep_settings
@@ -75,7 +81,7 @@ def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: s
         click.echo(note)
     cache = Cache(cache_dir or DEFAULT_CACHE_DIR)
     solver = SolverSettings()
-    folder = out_dir / s.name
+    folder = out_dir / (f"{s.name}-calibrated" if baseline is not None else s.name)
     run = run_sweep(s, folder, settings=solver, cache=cache, executor=executor, jobs=jobs, scheduler=scheduler,
                     quiet=quiet)
     ranked, choice = rank(run.rows, s)
@@ -87,12 +93,10 @@ def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: s
                f"{len(run.computed)} computed, {len(run.reused)} reused, {run.wall_s:.1f} s")
     click.echo(choice.explanation)
     if baseline is not None:
-        base_run = run_sweep(baseline, folder, settings=solver, cache=cache,
+        base_run = run_sweep(baseline, out_dir / baseline.name, settings=solver, cache=cache,
                              executor=executor, jobs=jobs, scheduler=scheduler, quiet=quiet)
         base_ranked, base_choice = rank(base_run.rows, baseline)
-        before = base_ranked.loc[base_choice.index, "candidate"] if base_choice.index is not None else "none"
-        after = ranked.loc[choice.index, "candidate"] if choice.index is not None else "none"
-        click.echo(f"calibration: choice {'unchanged' if before == after else 'changes'}: {before} -> {after}")
+        click.echo(calibration_summary(base_ranked, base_choice, ranked, choice, s))
     for kind, paths in written.items():
         for p in paths:
             if not quiet:

@@ -2,7 +2,10 @@
 plain NumPy path with the same outputs. A bundle directory holds:
 
 - ``corrector.pt``: TorchScript; ``forward(x)`` maps raw SI inputs (B, d) to commands (B,) rad;
-  ``input_names()`` / ``input_units()`` list the inputs; ``meta.json`` is embedded as an extra file.
+  ``input_names()`` / ``input_units()`` list the inputs; ``step(knee, target_rad, measured)`` runs
+  it online (one knee, one control step: history window and right-knee mirroring inside,
+  ``measured_names()`` lists the channels, ``reset()`` starts a trial); ``meta.json`` is
+  embedded as an extra file.
 - ``corrector.npz``: weights and normalisation for `NumpyCorrector`.
 - ``meta.json``: dataset spec, model kind, k, split, training settings and curve, versions.
 """
@@ -19,7 +22,8 @@ import torch
 from torch import nn
 
 from seadesign import __version__
-from seadesign.corrector.modalities import unit_of
+from seadesign.corrector.dataset import DatasetSpec
+from seadesign.corrector.modalities import MIRRORED_CHANNELS, channels, unit_of
 from seadesign.corrector.models import CorrectorNet, MLPCore, SiameseCore
 from seadesign.errors import SeadesignError
 
@@ -27,16 +31,32 @@ LEAKY_SLOPE = 0.01  # torch.nn.LeakyReLU default
 
 
 class _Exported(nn.Module):
-    """TorchScript wrapper carrying the input list and units."""
+    """TorchScript wrapper: the network on flat raw inputs (`forward`), and the online path
+    `step` that keeps each knee's history window and applies the right knee's mirroring, exactly
+    as the training dataset laid the inputs out (`FeatureBuilder`)."""
 
     names: list[str]
     units: list[str]
+    measured: list[str]
+    siamese: bool
+    n_channels: int
+    hall: int
 
-    def __init__(self, net: CorrectorNet, names: list[str], units: list[str]) -> None:
+    def __init__(self, net: CorrectorNet, names: list[str], units: list[str], spec: DatasetSpec) -> None:
         super().__init__()
         self.net = net
         self.names = names
         self.units = units
+        self.siamese = isinstance(net.core, SiameseCore)
+        chans = list(channels(spec.modalities))
+        self.n_channels = len(chans)
+        self.measured = chans + (["hall_pos_rad"] if self.siamese and "hall_pos_rad" not in chans else [])
+        self.hall = self.measured.index("hall_pos_rad") if self.siamese else -1
+        flip = [-1.0 if n.split("@")[0] in MIRRORED_CHANNELS else 1.0 for n in spec.feature_names()]
+        self.register_buffer("flip_right", torch.tensor(flip if spec.positive else [1.0] * len(flip)))
+        self.register_buffer("sign_right", torch.tensor(-1.0 if spec.positive else 1.0))
+        self.register_buffer("past", torch.zeros(2, spec.history + 1, len(self.measured)))
+        self.register_buffer("count", torch.zeros(2, dtype=torch.long))
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         return self.net(x)
@@ -48,6 +68,40 @@ class _Exported(nn.Module):
     @torch.jit.export
     def input_units(self) -> list[str]:
         return self.units
+
+    @torch.jit.export
+    def measured_names(self) -> list[str]:
+        """Channels `step` takes each control step, in order (robot frame, SI)."""
+        return self.measured
+
+    @torch.jit.export
+    def reset(self) -> None:
+        """Forget both knees' history (start of a trial)."""
+        self.past.zero_()
+        self.count.zero_()
+
+    @torch.jit.export
+    def step(self, knee: int, target_rad: float, measured: torch.Tensor) -> float:
+        """One control step of one knee (0 left, 1 right): target (rad) and the measured_names
+        channels -> motor command (rad), robot frame."""
+        if knee != 0 and knee != 1:
+            raise ValueError("knee must be 0 (left) or 1 (right)")
+        if measured.shape[0] != len(self.measured):
+            raise ValueError("measured must hold the channels listed by measured_names()")
+        m = measured.to(torch.float32)
+        if int(self.count[knee]) == 0:
+            self.past[knee] = m.expand(self.past.shape[1], m.shape[0])
+        else:
+            self.past[knee, 1:] = self.past[knee, :-1].clone()
+            self.past[knee, 0] = m
+        self.count[knee] += 1
+        window = self.past[knee, :, : self.n_channels].reshape(-1)
+        flip = self.flip_right if knee == 1 else torch.ones_like(self.flip_right)
+        x = torch.cat([torch.tensor([target_rad], dtype=torch.float32), window]) * flip
+        if self.siamese:  # x_t: the measured Hall position as target (thesis 6.2.3)
+            x = torch.cat([torch.cat([self.past[knee, 0, self.hall : self.hall + 1], window]) * flip, x])
+        u = self.net(x.unsqueeze(0))[0]
+        return float(u * self.sign_right) if knee == 1 else float(u)
 
 
 def versions() -> dict[str, str]:
@@ -124,7 +178,10 @@ class NumpyCorrector:
 
 
 def export_bundle(net: CorrectorNet, meta: dict[str, Any], out_dir: str | Path) -> Path:
-    """Write corrector.pt, corrector.npz and meta.json into `out_dir`."""
+    """Write corrector.pt, corrector.npz and meta.json into `out_dir`; meta["dataset"] is the
+    DatasetSpec as a dict (it fixes the online path's history and mirroring)."""
+    d = meta["dataset"]
+    spec = DatasetSpec(d["task"], tuple(d["modalities"]), d["history"], d["positive"])
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     names = list(meta["inputs"])
@@ -133,7 +190,7 @@ def export_bundle(net: CorrectorNet, meta: dict[str, Any], out_dir: str | Path) 
     text = json.dumps(meta, indent=2, default=_json_default)
     with warnings.catch_warnings():  # TorchScript is deprecated upstream but is the requested format
         warnings.simplefilter("ignore", DeprecationWarning)
-        scripted = torch.jit.script(_Exported(net.cpu().eval(), names, units))
+        scripted = torch.jit.script(_Exported(net.cpu().eval(), names, units, spec))
         torch.jit.save(scripted, str(out / "corrector.pt"), _extra_files={"meta.json": text})
     np.savez(out / "corrector.npz", **numpy_arrays(net))
     (out / "meta.json").write_text(text + "\n")
@@ -167,4 +224,4 @@ def load_torchscript(bundle: str | Path, freeze: bool = True) -> torch.jit.Scrip
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
         mod = torch.jit.load(str(Path(bundle) / "corrector.pt"), map_location="cpu").eval()
-        return torch.jit.freeze(mod, preserved_attrs=["input_names", "input_units"]) if freeze else mod
+        return torch.jit.freeze(mod, preserved_attrs=["input_names", "input_units", "measured_names", "reset", "step"]) if freeze else mod
