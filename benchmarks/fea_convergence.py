@@ -71,6 +71,8 @@ def main() -> None:
                 hs.append(1.0 / f)  # relative element size
                 ks.append(k)
                 print(f"{f:>7g}{w / (f * st.mesh.elements_across_beam):>8.3f}{tets:>9}{k:>12.5f}{s:>8.1f}", flush=True)
+            if len(ks) < 3:
+                continue
             r = richardson(hs, ks)
             print(f"Richardson (finest three): k0 = {r['extrapolated']:.5f} Nm/rad, observed order {r['order']:.2f}")
             for f, h, k in zip(refinements, hs, ks):
