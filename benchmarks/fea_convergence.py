@@ -3,8 +3,9 @@ fresh pytetwild meshings.
 
 Usage: python benchmarks/fea_convergence.py [--study wolfgang_knee] [--candidates 3x4,8x6,6x8]
        [--refinements 0.667,1,1.5,2.25] [--backend gmsh] [--spread N]
-Prints, per candidate, k at each refinement (a factor on the study's elements across the beam
-elements per turn on curved surfaces and layers: 1 is the study's default mesh), the extrapolated k,
+Prints, per candidate, k and the peak stall von Mises stress at each refinement (a factor on
+the study's elements across the beam, elements per turn on curved surfaces and layers: 1 is the
+study's default mesh), whether the peak converges, the extrapolated k,
 the observed order, each size's estimated discretization error, and the sweep's two-level
 estimate at the default (default vs the 1.5x coarser mesh) next to it; with --spread N, N fresh
 pytetwild meshes of the first candidate at the study's size and the spread (max - min) / mean of k.
@@ -22,21 +23,24 @@ import numpy as np
 
 from seadesign.candidates import check_candidate, find_candidate
 from seadesign.fea.convergence import richardson
-from seadesign.fea.torsion import solve_unit_torsion
+from seadesign.fea.loadcases import analyse
 from seadesign.mesh import mesh_part
 from seadesign.stages import COARSENING, CONVERGENCE_ORDER
 from seadesign.study import load_study
 
 
-def k_at(st, part, width, refinement, backend, cache_dir) -> tuple[float, int, float]:
+def k_at(st, part, width, refinement, backend, cache_dir) -> tuple[float, float, int, float]:
+    """k (Nm/rad), peak stall von Mises (MPa), tetrahedra and seconds at one refinement."""
     t = time.perf_counter()
     sizing = st.mesh.scaled(refinement).mesh_part_options()
     if backend == "pytetwild":
         sizing.update(elements_per_circle=0.0, layers=0)
     mesh = mesh_part(part.solid, part.interfaces, beam_width_mm=width, cache_dir=cache_dir,
                      **{**sizing, "backend": backend}, max_tets=1_500_000, timeout_s=600)
-    sol = solve_unit_torsion(mesh, st.material.youngs_modulus_Pa, st.material.poisson_ratio)
-    return 1.0 / float(sol.hub_motion[5]), len(mesh.tets), time.perf_counter() - t
+    m, lc = st.material, st.load_cases
+    r = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, lc.stall_torque_Nm,
+                lc.impact_torque_Nm, st.bearing_radius_mm).results
+    return r["k_Nm_per_rad"], r["stall_von_mises_max_MPa"], len(mesh.tets), time.perf_counter() - t
 
 
 def main() -> None:
@@ -63,23 +67,31 @@ def main() -> None:
         parts.append((int(n), float(w), checked.part))
     with tempfile.TemporaryDirectory() as cache:
         for n, w, part in parts:
-            hs, ks = [], []
+            hs, ks, peaks = [], [], []
             print(f"\n{n} beams / {w:g} mm")
-            print(f"{'refine':>7}{'h mm':>8}{'tets':>9}{'k Nm/rad':>12}{'s':>8}")
+            print(f"{'refine':>7}{'h mm':>8}{'tets':>9}{'k Nm/rad':>12}{'stall vM max MPa':>18}{'s':>8}")
             for f in refinements:
-                k, tets, s = k_at(st, part, w, f, args.backend, cache)
+                k, vm, tets, s = k_at(st, part, w, f, args.backend, cache)
                 hs.append(1.0 / f)  # relative element size
                 ks.append(k)
-                print(f"{f:>7g}{w / (f * st.mesh.elements_across_beam):>8.3f}{tets:>9}{k:>12.5f}{s:>8.1f}", flush=True)
+                peaks.append(vm)
+                print(f"{f:>7g}{w / (f * st.mesh.elements_across_beam):>8.3f}{tets:>9}{k:>12.5f}{vm:>18.4f}{s:>8.1f}",
+                      flush=True)
             if len(ks) < 3:
                 continue
+            steps = np.diff(peaks)
+            print("peak stall von Mises, change per refinement step: "
+                  + ", ".join(f"{100 * d / p:+.2f} %" for d, p in zip(steps, peaks[:-1]))
+                  + (" (one sign, shrinking: converging)" if np.all(np.abs(steps[1:]) < np.abs(steps[:-1]))
+                     and len(set(np.sign(steps))) == 1 else " (not a converging sequence)"))
             r = richardson(hs, ks)
             print(f"Richardson (finest three): k0 = {r['extrapolated']:.5f} Nm/rad, observed order {r['order']:.2f}")
             for f, h, k in zip(refinements, hs, ks):
                 print(f"  refinement {f:g}: error against k0 {100 * (k - r['extrapolated']) / r['extrapolated']:+.2f} %")
-            if 1.0 in refinements and 1 / COARSENING in [round(f, 3) for f in refinements]:
+            coarse = round(1 / COARSENING, 3)
+            if 1.0 in refinements and coarse in [round(f, 3) for f in refinements]:
                 k1 = ks[refinements.index(1.0)]
-                kc = ks[[round(f, 3) for f in refinements].index(1 / COARSENING)]
+                kc = ks[[round(f, 3) for f in refinements].index(coarse)]
                 est = abs(kc - k1) / k1 / (COARSENING**CONVERGENCE_ORDER - 1.0)
                 print(f"  sweep's two-level estimate at the default: {100 * est:.2f} % "
                       f"(order {CONVERGENCE_ORDER:g} assumed)")
@@ -88,7 +100,7 @@ def main() -> None:
             ks = []
             for i in range(args.spread):
                 with tempfile.TemporaryDirectory() as fresh:
-                    k, tets, s = k_at(st, part, w, 1.0, "pytetwild", fresh)
+                    k, _, tets, s = k_at(st, part, w, 1.0, "pytetwild", fresh)
                 ks.append(k)
                 print(f"pytetwild fresh mesh {i + 1}: {tets} tets, k = {k:.5f} Nm/rad ({s:.0f} s)", flush=True)
             ks = np.array(ks)
