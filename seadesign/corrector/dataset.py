@@ -87,6 +87,11 @@ class DatasetSpec:
             names.extend(f"{c}@t-{lag}" for c in chans)
         return tuple(names)
 
+    @classmethod
+    def from_dict(cls, d: dict) -> "DatasetSpec":
+        """The spec from its `to_dict` form (as stored in a bundle's meta.json)."""
+        return cls(d["task"], tuple(d["modalities"]), d["history"], d["positive"])
+
     def to_dict(self) -> dict:
         """JSON-ready form."""
         d = asdict(self)

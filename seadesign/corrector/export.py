@@ -180,8 +180,7 @@ class NumpyCorrector:
 def export_bundle(net: CorrectorNet, meta: dict[str, Any], out_dir: str | Path) -> Path:
     """Write corrector.pt, corrector.npz and meta.json into `out_dir`; meta["dataset"] is the
     DatasetSpec as a dict (it fixes the online path's history and mirroring)."""
-    d = meta["dataset"]
-    spec = DatasetSpec(d["task"], tuple(d["modalities"]), d["history"], d["positive"])
+    spec = DatasetSpec.from_dict(meta["dataset"])
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     names = list(meta["inputs"])

@@ -97,8 +97,7 @@ def find_bundles(paths: list[str | Path]) -> list[Path]:
 def load_corrector(bundle: str | Path) -> tuple[NetCorrector, dict[str, Any]]:
     """A bundle as an online corrector (NumPy path) plus its meta."""
     meta = load_meta(bundle)
-    d = meta["dataset"]
-    spec = DatasetSpec(d["task"], tuple(d["modalities"]), d["history"], d["positive"])
+    spec = DatasetSpec.from_dict(meta["dataset"])
     return NetCorrector(load_numpy(bundle), spec, meta["name"]), meta
 
 
@@ -108,8 +107,7 @@ def evaluation_rows(meta: dict, data_paths: list[str | Path], recs: list[Recordi
     Files the bundle was trained on contribute only the held-out rows of its own split (rebuilt
     with the same settings); files it never saw contribute every row.
     """
-    d = meta["dataset"]
-    spec = DatasetSpec(d["task"], tuple(d["modalities"]), d["history"], d["positive"])
+    spec = DatasetSpec.from_dict(meta["dataset"])
     ds = build_dataset(recs, spec)
     trained = {r["sha256"] for r in meta["data"]}
     seen = np.array([file_digest(p) in trained for p in data_paths])

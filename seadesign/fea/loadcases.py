@@ -147,19 +147,3 @@ def analyse(
     )
     return Analysis(unit=unit, stress_per_Nm_Pa=stress, hub_torque_Nm=torque, results=results)
 
-
-def solve_load_cases(
-    mesh: TetMesh,
-    youngs_modulus_Pa: float,
-    poisson_ratio: float,
-    yield_strength_Pa: float,
-    stall_torque_Nm: float,
-    impact_torque_Nm: float,
-    bearing_radius_mm: float,
-    **options,
-) -> dict[str, float]:
-    """Plain-number results of both load cases (keys carry units); options as in analyse()."""
-    return analyse(
-        mesh, youngs_modulus_Pa, poisson_ratio, yield_strength_Pa, stall_torque_Nm, impact_torque_Nm,
-        bearing_radius_mm, **options,
-    ).results
