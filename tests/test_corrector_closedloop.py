@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from seadesign.corrector.closedloop import closed_loop_table, run_closed_loop
@@ -55,3 +56,40 @@ def test_closed_loop_refuses_unknown_setting(spring_dict):
 
     with pytest.raises(SeadesignError, match="hanging or ground"):
         closed_loop_table([NoCorrection()], spring_dict, ("upside_down",), [Trial("front", 0.1, 1.0)])
+
+
+def test_unstable_run_keeps_the_samples_before_the_stop(spring_dict):
+    """A run stopped for instability still yields the robot-format rows it ran, usable as training data."""
+    from seadesign.corrector.recordings import recording_from_table
+
+    trials = [Trial("front", 0.1, 2.5), Trial("back_right", 0.2, 2.5)]
+    run = run_closed_loop(HallPI(kp=-1.5, ki=0.0, name="positive_feedback"), spring_dict, trials)
+    assert run.unstable
+    logged = int(np.isfinite(run.command[0, :, 0]).sum()) - 1  # the last command was refused, not sent
+    assert run.recording is not None and len(run.recording) == 2 * logged < 2 * 250
+    np.testing.assert_allclose(run.recording["l_hall_pos"].to_numpy()[:logged], run.hall[0, :logged, 0])
+    rec, _ = recording_from_table(run.recording, "unstable")
+    assert len(rec.time_s) > 0 and len(np.unique(rec.segment)) >= 2  # the two trials never pair across
+
+
+def test_iterate_adds_each_rounds_run_to_the_pool(spring_dict):
+    """Round r trains on the start run plus the runs of rounds < r: the pool and the samples grow by
+    the previous round's recording, and every round is scored in closed loop."""
+    from seadesign.corrector.dataset import DatasetSpec
+    from seadesign.corrector.iterative import iterate
+    from seadesign.corrector.train import TrainConfig
+
+    trials = [Trial("front", 0.1, 2.0), Trial("rotate_right", 0.2, 2.0)]
+    cfg = TrainConfig(model="mlp", max_epochs=30, patience=10, batch_size=256, seed=3)
+    spec = DatasetSpec(task="command", modalities="velocity_effort", positive=True)
+    table, results = iterate(spring_dict, [], spec, cfg, rounds=2, trials=trials, seed=1)
+    assert list(table["round"]) == [0, 1, 2] and len(results) == 3
+    assert list(table["n_recordings"]) == [1, 2, 3]
+    grown = np.diff(table["n_samples"].to_numpy())
+    assert np.all(grown > 0)
+    recorded = table["recorded_s"].to_numpy()
+    stable = ~table["unstable_flag"].to_numpy(bool)
+    np.testing.assert_allclose(recorded[stable], 2 * 2.0)  # a completed run records both trials in full
+    assert np.isfinite(table["mean_abs_error_rad"]).all()
+    again, _ = iterate(spring_dict, [], spec, cfg, rounds=2, trials=trials, seed=1)
+    pd.testing.assert_frame_equal(table, again)  # seeded: the same rounds, numbers and flags

@@ -124,3 +124,22 @@ def test_bench_linear_spring_and_round_trip(tmp_path, spring_dict):
     back = read_bench(write_bench(df, tmp_path / "bench.csv", meta))
     pd.testing.assert_frame_equal(df, back)
     assert back.attrs["metadata"]["protocol"]["profile"] == "sine"
+
+
+def test_partial_recording_is_the_full_runs_prefix(spring_dict):
+    """Stopped at sample m, the recording holds each trial's first m rows of the full run (same seed and
+    commands), at the full run's times; the command's rate at the cut is the only one-sided column."""
+    full = _session(spring_dict, seed=4).run()
+    part = _session(spring_dict, seed=4)
+    with pytest.raises(Exception, match="partial"):
+        part.recording()
+    m = 57
+    for _ in range(m):
+        part.step()
+    got = part.recording(partial=True)
+    n_steps = len(full) // 2
+    prefix = pd.concat([full.iloc[:m], full.iloc[n_steps:n_steps + m]], ignore_index=True)
+    assert len(got) == 2 * m and part.n_logged == m
+    same = [c for c in full.columns if not c.endswith(("_cmd_vel", "_cmd_acc"))]
+    pd.testing.assert_frame_equal(got[same], prefix[same])
+    assert np.allclose(got["l_cmd_vel"].to_numpy()[: m - 2], prefix["l_cmd_vel"].to_numpy()[: m - 2])

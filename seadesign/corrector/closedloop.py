@@ -55,7 +55,7 @@ class ClosedLoopRun:
     unstable: bool
     oscillating: bool
     note: str = ""
-    recording: pd.DataFrame | None = None  # robot-format table of a completed run
+    recording: pd.DataFrame | None = None  # robot-format table of the samples run (all, or those before a stop)
 
 
 def _needs_aux(corrector: Corrector) -> bool:
@@ -98,7 +98,7 @@ def run_closed_loop(corrector: Corrector, spring: dict[str, Any], trials: list[T
             unstable, note = True, f"simulator refused the command at step {obs.step}: {exc}"
             break
     chatter = chatter_rms(command, target, rate_hz)
-    table = sim.recording() if sim.done else None
+    table = sim.recording(partial=True) if sim.n_logged >= 2 else None
     return ClosedLoopRun(corrector.name, rate_hz, trials, target, hall, command, effort, unstable,
                          bool(np.nanmax(chatter) > CHATTER_RMS_RAD), note, table)
 

@@ -4,7 +4,8 @@ corrector in the loop.
 Round 0 trains on the given recordings (or, without any, on a simulated run with no correction).
 Each round then drives the knee simulator through the protocol with the round's corrector, scores
 it (closed-loop table row), cleans the simulated recording with the data module's steps and adds it
-to the training pool for the next round.
+to the training pool for the next round. A run that goes unstable adds the samples recorded before
+it stopped (the states the corrector drove the knee into are what the next round must learn).
 """
 
 from __future__ import annotations
@@ -49,8 +50,10 @@ def iterate(spring: dict[str, Any], recordings: list[Recording], spec: DatasetSp
         net = NetCorrector(NumpyCorrector(numpy_arrays(res.net)), spec, f"{config.model} round {r}")
         run = run_closed_loop(net, spring, trials, ground=ground, seed=seed + r + 1)
         rows.append({"round": r, "n_recordings": len(pool), "n_samples": len(ds),
-                     "val_mse_rad2": res.summary()["best_val_mse_rad2"], **summary_row(run, setting)})
-        if run.recording is None:  # unstable: nothing usable to add
+                     "val_mse_rad2": res.summary()["best_val_mse_rad2"],
+                     "recorded_s": 0.0 if run.recording is None else len(run.recording) / run.rate_hz,
+                     **summary_row(run, setting)})
+        if run.recording is None:  # stopped before two samples: nothing to add
             break
         pool.append(recording_from_table(run.recording, f"sim_round_{r}")[0])
     return pd.DataFrame(rows), results

@@ -141,20 +141,36 @@ class KneeSession:
             obs = self.step(None if controller is None else controller(obs))
         return self.recording()
 
-    def recording(self) -> pd.DataFrame:
-        """The logged samples in the robot format's table (as `read_recording` returns), trials in order."""
-        if not self.done:
-            raise ConfigError(f"the session is at sample {self._k} of {self.n_steps}; step to the end first")
-        n = self.n_trials * self.n_steps
+    @property
+    def n_logged(self) -> int:
+        """Samples logged so far per trial."""
+        return self._k
+
+    def recording(self, partial: bool = False) -> pd.DataFrame:
+        """The logged samples in the robot format's table (as `read_recording` returns), trials in order.
+
+        A finished session gives every sample. With `partial`, an unfinished one gives the samples
+        logged so far (each trial's first `n_logged`, at the times they would have in the full run,
+        so trials stay separated by a time gap): the full run's rows up to that sample, except that the
+        command's rate and acceleration at the cut are one-sided differences.
+        """
+        if not self.done and not partial:
+            raise ConfigError(f"the session is at sample {self._k} of {self.n_steps}; step to the end first "
+                              "or ask for the partial recording")
+        m = self._k
+        if m < 2:
+            raise ConfigError(f"the session has logged {m} sample(s); a recording needs at least 2")
+        n = self.n_trials * m
         duration = self.n_steps * self.dt
-        stamp = self.start_time_s + (np.arange(self.n_trials)[:, None] * duration + self.time[None, :])
+        stamp = self.start_time_s + (np.arange(self.n_trials)[:, None] * duration + self.time[None, :m])
         out: dict[str, Any] = {"time_s": (stamp - stamp[0, 0]).ravel(), "timestamp": stamp.ravel()}
         for k, side in enumerate("lr"):
             for field in FIELDS:
-                out[f"{side}_{field}"] = self._log[field][:, :, k].ravel()
-        out.update(self._imu_and_pressure())
+                out[f"{side}_{field}"] = self._log[field][:, :m, k].ravel()
+        out.update({c: v.reshape(self.n_trials, self.n_steps)[:, :m].ravel()
+                    for c, v in self._imu_and_pressure().items()})
         out["has_command"] = np.ones(n, dtype=bool)
-        cmd = self._log["command"]
+        cmd = self._log["command"][:, :m]
         vel = np.gradient(cmd, self.dt, axis=1)
         acc = np.gradient(vel, self.dt, axis=1)
         for k, side in enumerate("lr"):
