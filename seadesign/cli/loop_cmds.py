@@ -8,7 +8,7 @@ import click
 import pandas as pd
 
 from seadesign.cli import main
-from seadesign.data import clean, read_bench, read_recording
+from seadesign.data import clean, is_hanging, read_bench, read_recording
 from seadesign.errors import ConfigError
 from seadesign.handoff import load_spring
 from seadesign.loop import ROLES, LIBRARY, explain, from_frame
@@ -51,9 +51,10 @@ def _kind(path: Path) -> str:
               help="Bench files: predict torque (Nm) from deflection, or deflection (rad) from torque.")
 @click.option("--knee", type=click.Choice(["l", "r"]), default="l", show_default=True,
               help="Robot recordings: which knee (l left, r right; the right is un-mirrored).")
-@click.option("--keep-lifted/--drop-lifted", default=True, show_default=True,
-              help="Robot recordings: keep rows whose foot pressure sum is low (robot hanging). Recordings are "
-                   "cleaned first (artefact rows dropped, wrap-arounds unwrapped, Hall offsets removed).")
+@click.option("--keep-lifted/--drop-lifted", default=None,
+              help="Robot recordings: keep rows whose foot pressure sum is low (foot lifted); default: keep them "
+                   "only in a hanging recording (every row low). Recordings are cleaned first (artefact rows "
+                   "dropped, wrap-arounds unwrapped, Hall offsets removed at unloaded rest).")
 @click.option("--measured", default=None, help="Generic table: column of the measured quantity (any unit).")
 @click.option("--predicted", default=None, help="Generic table: column of the model's prediction (unit of --measured).")
 @click.option("--signal", "signals", multiple=True,
@@ -61,11 +62,12 @@ def _kind(path: Path) -> str:
 @click.option("--unit", "units", multiple=True, help="Generic table: ROLE=UNIT for the report, e.g. displacement=rad.")
 @click.option("--measured-unit", default="1", show_default=True, help="Generic table: unit of --measured.")
 @click.option("--declare", multiple=True, type=click.Choice(sorted(LIBRARY)),
-              help="Effect already in the prediction (not traced); repeatable. Robot files declare dead_band and friction.")
+              help="Effect already in the prediction (not traced); repeatable. Robot files declare dead_band "
+                   "(backlash) and friction (gear friction) unless --declare is given; then only those given.")
 @click.option("--min-gain", type=click.FloatRange(0.0, 1.0), default=0.05, show_default=True,
               help="Relative held-out RMSE cut (fraction) an effect needs to be added.")
 def explain_cmd(file: Path, spring_path: Path | None, json_out: Path | None, out_dir: Path, predict: str, knee: str,
-                keep_lifted: bool, measured: str | None, predicted: str | None, signals: tuple[str, ...],
+                keep_lifted: bool | None, measured: str | None, predicted: str | None, signals: tuple[str, ...],
                 units: tuple[str, ...], measured_unit: str, declare: tuple[str, ...], min_gain: float) -> None:
     """Explain the residual between a model and measured FILE: missing effects, refit, error before and after.
 
@@ -87,9 +89,11 @@ def explain_cmd(file: Path, spring_path: Path | None, json_out: Path | None, out
             data = bench_loop_data(read_bench(file), spring, predict)
             declared, loop_plot, stem = tuple(declare), True, file.stem
         else:
-            table = clean(read_recording(file), keep_lifted=keep_lifted, normalise=False, euler=False).table
-            data = robot_loop_data(table, spring, knee)
+            raw = read_recording(file)
+            keep = is_hanging(raw) if keep_lifted is None else keep_lifted
+            table = clean(raw, keep_lifted=keep, normalise=False, euler=False).table
             declared, loop_plot, stem = tuple(declare) or ROBOT_DECLARED, False, f"{file.stem}_{knee}"
+            data = robot_loop_data(table, spring, knee, declared)
     ex = explain(data, declared, min_gain=min_gain)
     cal = calibration(ex, spring, str(file)) if spring is not None else None
     paths = write_report(ex, out_dir, stem, f"Explain {file.name}", loop_plot=loop_plot, calibration=cal)

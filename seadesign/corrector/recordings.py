@@ -22,7 +22,7 @@ import pandas as pd
 
 from seadesign.corrector.dataset import COMMAND, Recording
 from seadesign.corrector.modalities import IMU_CHANNELS, PRESSURE_CHANNELS
-from seadesign.data import clean, read_recording
+from seadesign.data import clean, is_hanging, read_recording
 from seadesign.errors import DataError
 
 GAP_FACTOR = 10.0
@@ -77,8 +77,7 @@ def recording_from_table(df: pd.DataFrame, name: str) -> tuple[Recording, list[d
     """Clean a robot-format table (`read_recording` or the simulator's) and convert it."""
     df = df.copy()
     df["source_row"] = np.arange(len(df))
-    cells = [c for c in df.columns if "_pressure_" in c]
-    hanging = bool((df[cells].to_numpy(dtype=float).sum(axis=1) < PRESSURE_THRESHOLD).all())
+    hanging = is_hanging(df, PRESSURE_THRESHOLD)
     res = clean(df, pressure_threshold=PRESSURE_THRESHOLD, keep_lifted=hanging, normalise=False, positive=False)
     meta = df.attrs.get("metadata") or {}
     setting = str(meta.get("setting", "hanging" if hanging else "ground"))

@@ -17,13 +17,13 @@ Every malformed input raises `seadesign.errors.DataError` naming line, row and c
 
 from seadesign.data.artefacts import ArtefactReport, Thresholds, detect_artefacts
 from seadesign.data.bench import BENCH_OPTIONAL, BENCH_REQUIRED, read_bench, write_bench
-from seadesign.data.cleaning import CleanResult, clean, quaternion_to_euler, write_cleaned
+from seadesign.data.cleaning import CleanResult, clean, is_hanging, quaternion_to_euler, write_cleaned
 from seadesign.data.metadata import read_metadata, sidecar_path, write_metadata
 from seadesign.data.plots import plot_recording
 from seadesign.data.robot import KNEE_SIGN, KNEES, RECORDING_COLUMNS, read_recording, write_recording
 
 __all__ = [
-    "ArtefactReport", "CleanResult", "plot_recording", "Thresholds", "clean", "detect_artefacts", "quaternion_to_euler", "write_cleaned",
+    "ArtefactReport", "CleanResult", "plot_recording", "Thresholds", "clean", "detect_artefacts", "is_hanging", "quaternion_to_euler", "write_cleaned",
     "BENCH_OPTIONAL", "BENCH_REQUIRED", "KNEES", "KNEE_SIGN", "RECORDING_COLUMNS",
     "read_bench", "read_metadata", "read_recording", "sidecar_path", "write_bench",
     "write_metadata", "write_recording",

@@ -50,6 +50,12 @@ class CleanResult:
                                   + str({k: v for k, v in self.removed.items() if v})])
 
 
+def is_hanging(df: pd.DataFrame, pressure_threshold: float = 10.0) -> bool:
+    """True when every row's foot pressure sum (8 cells) is below the threshold: a hanging recording."""
+    pressure = df[PRESSURE_COLUMNS["l"] + PRESSURE_COLUMNS["r"]].to_numpy(dtype=float).sum(axis=1)
+    return bool((pressure < pressure_threshold).all())
+
+
 def clean(df: pd.DataFrame, *, pressure_threshold: float = 10.0, keep_lifted: bool = False,
           drop_artefacts: bool = True, unwrap: bool = True, remove_offset: bool = True,
           euler: bool = True, normalise: bool = True, positive: bool = False,

@@ -2,7 +2,12 @@
 
 Each `Candidate` maps (data, parameters, value) -> new value. Candidates of the torque path
 (stages below `LOAD_STAGE`) act on the path term of the prediction (the part that passes
-through the spring, see `LoopData.path`); the others act on the whole prediction. The forward
+through the spring, see `LoopData.path`); the others act on the whole prediction. In the
+compliance direction (the path is a deflection computed as torque / k) a spring-torque term
+enters divided by k, so its parameters are relative to k (hysteresis tau_h / k and sigma / k,
+viscoelastic k2 / k, cubic k3 / k), softening divides the path, and thermal softening takes its
+heat from the `torque` signal. Cubic stiffening and the viscoelastic arm are inverted exactly
+there (a Newton solve of the cubic, the inverse of the standard-linear-solid filter). The forward
 models are those of the shared effect library (`seadesign.effects`) where its form fits the
 fit: dead-band, temperature softening and gravity call the library's effect
 objects. The rest are written here because the fit needs what the library does not offer:
@@ -20,9 +25,9 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from scipy.signal import lfilter
+from scipy.signal import lfilter, lfilter_zi
 
-from seadesign.effects import DahlHysteresis, DeadBand, GravityLoad, Param, TemperatureSoftening
+from seadesign.effects import DeadBand, GravityLoad, Param, TemperatureSoftening
 from seadesign.loop.table import LoopData, smooth
 
 LOAD_STAGE = 7  # stages below act on the path term; from here on the whole prediction
@@ -42,11 +47,12 @@ class Candidate:
     params: Callable[[LoopData], tuple[Param, ...]]
     starts: Callable[[LoopData], list[list[float]]]
     apply: Apply
-    directions: tuple[str, ...] = ("stiffness", "compliance")
     log: tuple[int, ...] = ()  # indices of positive scale parameters fitted in log space
+    compliance_roles: tuple[str, ...] = ()  # further roles needed in the compliance direction
 
     def applicable(self, data: LoopData) -> bool:
-        return all(r in data.signals for r in self.roles) and data.direction in self.directions
+        roles = self.roles + (self.compliance_roles if data.direction == "compliance" else ())
+        return all(r in data.signals for r in roles)
 
 
 def _span(data: LoopData) -> float:
@@ -77,8 +83,23 @@ def _scale(data, th, path):
     return path * (th[0] if data.direction == "stiffness" else 1.0 / th[0])
 
 
+def solve_cubic(x: np.ndarray, r: float, iterations: int = 12) -> np.ndarray:
+    """d with d + r d^3 = x elementwise (Newton from d = x); for r < 0 d stays within the turning
+    points +-1/sqrt(-3 r), beyond which no deflection carries the torque."""
+    d = np.array(x, dtype=float)
+    turn = 1.0 / math.sqrt(-3.0 * r) if r < 0 else math.inf
+    for _ in range(iterations):
+        d = d - (d + r * d ** 3 - x) / np.maximum(1.0 + 3.0 * r * d * d, 1e-3)
+        if r < 0:
+            d = np.clip(d, -turn, turn)
+    return d
+
+
 def _cubic(data, th, path):
-    return path + th[0] * data.signals["displacement"] ** 3
+    x = data.signals["displacement"]
+    if data.direction == "stiffness":
+        return path + th[0] * x ** 3
+    return path + _g(data) * (solve_cubic(x, th[0]) - x)  # k d + k3 d^3 = k x, th[0] = k3 / k
 
 
 def dahl(d: np.ndarray, torque: float, stiffness: float, chunk: float = 500.0) -> np.ndarray:
@@ -86,16 +107,13 @@ def dahl(d: np.ndarray, torque: float, stiffness: float, chunk: float = 500.0) -
 
     The same recursion as `seadesign.effects.DahlHysteresis` (z_n = a_n z_{n-1} + (1 - a_n) s_n tau_h,
     a_n = exp(-sigma |dd_n| / tau_h)), solved in closed form over chunks in which the decay
-    exponent grows by at most `chunk`, so the exponentials stay finite.
+    exponent grows by at most `chunk`, so the exponentials stay finite (at most one chunk per sample).
     """
     step = np.diff(d, prepend=d[0])
     c = stiffness / torque
     decay = np.abs(step) * c
     v = np.cumsum(decay)
     b = np.sign(step) * torque * -np.expm1(-decay)
-    if v[-1] > chunk * d.size / 50:  # chunks would be short: the library's per-sample loop is faster
-        return DahlHysteresis().apply({"deflection": d, "torque": np.zeros_like(d)},
-                                      {"torque_Nm": torque, "stiffness_Nm_per_rad": stiffness})
     z = np.empty_like(v)
     ids = np.floor(v / chunk)
     starts = np.flatnonzero(np.diff(ids, prepend=-1.0))
@@ -107,8 +125,15 @@ def dahl(d: np.ndarray, torque: float, stiffness: float, chunk: float = 500.0) -
     return z
 
 
+def _add(data: LoopData, path: np.ndarray, term: np.ndarray) -> np.ndarray:
+    """Add a spring-torque term to the path: in the stiffness direction `term` is a torque (measured
+    unit); in the compliance direction it is that torque over k (displacement unit), which the true
+    deflection lacks: (torque - term k) / k = displacement - term, times the path's gain."""
+    return path + term if data.direction == "stiffness" else path - _g(data) * term
+
+
 def _hysteresis(data, th, path):
-    return path + dahl(data.smooth("displacement"), th[0], th[1])
+    return _add(data, path, dahl(data.smooth("displacement"), th[0], th[1]))
 
 
 def lowpass_uniform(x: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
@@ -119,8 +144,14 @@ def lowpass_uniform(x: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
 
 
 def _viscoelastic(data, th, path):
-    d = data.smooth("displacement")
-    return path + th[0] * (d - lowpass_uniform(d, data.time, th[1]))
+    x = data.smooth("displacement")
+    if data.direction == "stiffness":
+        return path + th[0] * (x - lowpass_uniform(x, data.time, th[1]))
+    # x = torque / k = d + r (d - lowpass(d)), r = k2 / k: invert the filter for the deflection d
+    r, a = th[0], math.exp(-float(np.median(np.diff(data.time))) / th[1])
+    b, den = [1.0, -a], [1.0 + r * a, -a * (1.0 + r)]
+    d, _ = lfilter(b, den, x, zi=lfilter_zi(b, den) * x[0])
+    return path + _g(data) * (d - x)
 
 
 def leaky_sum(h: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
@@ -129,19 +160,32 @@ def leaky_sum(h: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
     return lfilter([1.0], [1.0, -a], h)
 
 
-def _thermal(data, th, path):
+def _soften(data: LoopData, path: np.ndarray, factor: np.ndarray) -> np.ndarray:
+    """Stiffness times `factor`: the torque path scales by it, a deflection path by its inverse."""
+    return path * factor if data.direction == "stiffness" else path / factor
+
+
+def _thermal(data, th, path, iterations: int = 4):
     if "energy" in data.signals:
-        heat = data.signals["energy"] - data.signals["energy"][0]
-    else:
-        dd = np.diff(data.smooth("displacement"), prepend=data.smooth("displacement")[0])
-        heat = leaky_sum(np.abs(path * dd), data.time, th[1])
-    return path * np.maximum(1.0 - th[0] * heat, 0.05)
+        return _soften(data, path, np.maximum(1.0 - th[0] * (data.signals["energy"] - data.signals["energy"][0]), 0.05))
+    x = data.smooth("displacement")
+    if data.direction == "stiffness":
+        heat = leaky_sum(np.abs(path * np.diff(x, prepend=x[0])), data.time, th[1])
+        return path * np.maximum(1.0 - th[0] * heat, 0.05)
+    # the heat comes from the unsoftened torque k d = torque / f over the true deflection d = x / f,
+    # and f from the heat: a fixed point, from f = 1
+    torque, f = data.smooth("torque"), np.ones_like(x)
+    for _ in range(iterations):
+        d = x / f
+        f = np.maximum(1.0 - th[0] * leaky_sum(np.abs(torque / f * np.diff(d, prepend=d[0])), data.time, th[1]), 0.05)
+    return path / f
 
 
 def _temperature(data, th, path):
     t = data.signals["temperature"]
-    return TemperatureSoftening().apply({"temperature": t, "torque": path},
-                                        {"softening_per_K": th[0], "reference_temperature_C": float(t[0])})
+    factor = TemperatureSoftening().apply({"temperature": t, "torque": np.ones_like(t)},
+                                          {"softening_per_K": th[0], "reference_temperature_C": float(t[0])})
+    return _soften(data, path, factor)
 
 
 # -- loads and sensors on the whole prediction --------------------------------------------
@@ -171,6 +215,46 @@ def _delay(data, th, y):
     return y + np.interp(t - th[0], t, ys) - ys
 
 
+def _stiff(data: LoopData) -> float:
+    """Scale of a spring-torque term's slope: the path's gain (measured unit per displacement unit) in
+    the stiffness direction, 1 in the compliance direction (terms there are relative to k)."""
+    return abs(_g(data)) if data.direction == "stiffness" else 1.0
+
+
+def _cubic_params(data: LoopData) -> tuple[Param, ...]:
+    du, dmax = _u(data, "displacement"), _dmax(data)
+    if data.direction == "stiffness":
+        bound = 10 * _span(data) / dmax ** 3
+        return (Param("k3", f"{data.measured_unit}/{du}^3", 0.0, -bound, bound, "cubic stiffness coefficient"),)
+    return (Param("k3_ratio", f"1/{du}^2", 0.0, -10 / dmax ** 2, 10 / dmax ** 2,
+                  "cubic stiffness over k, k3 / k (the deflection solves d + (k3/k) d^3 = torque / k)"),)
+
+
+def _hysteresis_params(data: LoopData) -> tuple[Param, ...]:
+    du = _u(data, "displacement")
+    if data.direction == "stiffness":
+        return (Param("torque", data.measured_unit, 0.01 * _span(data), 1e-6, min(20.0, _span(data)),
+                      "saturation torque tau_h"),
+                Param("stiffness", f"{data.measured_unit}/{du}", abs(_g(data)), 1e-3, 1e5,
+                      "initial slope sigma after a reversal"))
+    return (Param("deflection", du, 0.01 * _dmax(data), 1e-6 * _dmax(data), _dmax(data),
+                  "saturation torque over k, tau_h / k"),
+            Param("stiffness_ratio", "1", 1.0, 1e-3, 1e5, "initial slope after a reversal over k, sigma / k"))
+
+
+def _hysteresis_starts(data: LoopData) -> list[list[float]]:
+    size = 0.02 * (_span(data) if data.direction == "stiffness" else _dmax(data))
+    return [[size, 3 * _stiff(data)], [size, 30 * _stiff(data)]]
+
+
+def _viscoelastic_params(data: LoopData) -> tuple[Param, ...]:
+    tr = Param("relaxation_time", "s", 1.0, 1e-3, 1e3, "relaxation time tr")
+    if data.direction == "stiffness":
+        return (Param("maxwell_stiffness", f"{data.measured_unit}/{_u(data, 'displacement')}", 0.0, 0.0,
+                      10 * abs(_g(data)) + _span(data) / _dmax(data), "stiffness k2 of the Maxwell arm"), tr)
+    return Param("maxwell_ratio", "1", 0.0, 0.0, 10.0, "Maxwell arm stiffness over k, k2 / k"), tr
+
+
 def _vel_scale(data) -> float:
     v = np.abs(data.signals["velocity"])
     return float(np.quantile(v, 0.9)) or 1.0
@@ -190,37 +274,26 @@ CANDIDATES: tuple[Candidate, ...] = (
     Candidate(
         "cubic_stiffening", "odd cubic term k3 d^3 (k3 > 0 stiffening, < 0 softening)",
         "odd cubic residual vs displacement", ("displacement",), 2,
-        lambda d: (Param("k3", f"{d.measured_unit}/{_u(d, 'displacement')}^3", 0.0, -10 * _span(d) / _dmax(d) ** 3,
-                         10 * _span(d) / _dmax(d) ** 3, "cubic stiffness coefficient"),),
-        lambda d: [[0.0]], _cubic),
+        _cubic_params, lambda d: [[0.0]], _cubic),
     Candidate(
         "hysteresis", "Dahl hysteresis: torque z, dz/dd = sigma (1 - z sign(dd) / tau_h)",
         "loop vs displacement that stays open at low frequency", ("displacement",), 3,
-        lambda d: (Param("torque", d.measured_unit, 0.01 * _span(d), 1e-6, min(20.0, _span(d)), "saturation torque tau_h"),
-                   Param("stiffness", f"{d.measured_unit}/{_u(d, 'displacement')}", abs(_g(d)), 1e-3, 1e5,
-                         "initial slope sigma after a reversal")),
-        lambda d: [[0.02 * _span(d), 3 * abs(_g(d))], [0.02 * _span(d), 30 * abs(_g(d))]], _hysteresis,
-        directions=("stiffness",), log=(0, 1)),
+        _hysteresis_params, _hysteresis_starts, _hysteresis, log=(0, 1)),
     Candidate(
         "viscoelastic", "standard linear solid: Maxwell arm k2 with relaxation time tr",
         "phase lead; loop that vanishes at low and high frequency", ("displacement",), 4,
-        lambda d: (Param("maxwell_stiffness", f"{d.measured_unit}/{_u(d, 'displacement')}", 0.0, 0.0,
-                         10 * abs(_g(d)) + _span(d) / _dmax(d), "stiffness k2 of the Maxwell arm"),
-                   Param("relaxation_time", "s", 1.0, 1e-3, 1e3, "relaxation time tr")),
-        lambda d: [[0.1 * abs(_g(d)), tr] for tr in (0.05, 0.5, 5.0)], _viscoelastic,
-        directions=("stiffness",), log=(1,)),
+        _viscoelastic_params, lambda d: [[0.1 * _stiff(d), tr] for tr in (0.05, 0.5, 5.0)], _viscoelastic, log=(1,)),
     Candidate(
         "thermal_softening", "stiffness x (1 - c H), H = heat from dissipated energy with cooling time tc",
         "drift that tracks cumulative dissipated energy", ("displacement",), 5,
         lambda d: (Param("softening_per_J", "1/J", 0.0, 0.0, 1.0, "relative stiffness loss c per joule of retained heat"),
                    Param("cooling_time", "s", 600.0, 1.0, 1e6, "cooling time constant tc")),
-        lambda d: [[1e-3, tc] for tc in (30.0, 300.0, 3000.0)], _thermal,
-        directions=("stiffness",), log=(1,)),
+        lambda d: [[1e-3, tc] for tc in (30.0, 300.0, 3000.0)], _thermal, log=(1,), compliance_roles=("torque",)),
     Candidate(
         "temperature_softening", "stiffness x (1 - a (T - T0)), T0 the first sample's temperature",
         "drift that tracks temperature", ("temperature",), 6,
         lambda d: (Param("softening_per_K", "1/K", 0.0, 0.0, 0.05, "relative stiffness loss a per kelvin"),),
-        lambda d: [[0.005]], _temperature, directions=("stiffness",)),
+        lambda d: [[0.005]], _temperature),
     Candidate(
         "friction", "Coulomb + viscous: Fc tanh(v / vs) + Fv v",
         "jump at v = 0 and slope vs v", ("velocity",), 7,

@@ -8,7 +8,8 @@ calibration that flows back into the design.
   motor angle minus the deflection the effort implies through the simulator's declared chain
   (gear friction taken off the effort, the spring, the gearbox backlash as free travel):
   hall = motor - (effort - gear friction(motor velocity)) / k - sign(.) backlash / 2.
-  Declared effects (not traced): `dead_band` (backlash) and `friction` (gear friction).
+  Declared effects (not traced) by default: `dead_band` (backlash) and `friction` (gear
+  friction); signals time, displacement (spring deflection), velocity (motor), torque (spring).
 """
 
 from __future__ import annotations
@@ -41,15 +42,21 @@ def bench_loop_data(df: pd.DataFrame, spring: dict[str, Any], predict: str = "to
                         measured_unit="Nm", units=units, columns={**columns, "displacement": "deflection_rad",
                                                                   "measured": "torque_Nm"}, gain=k)
     if predict == "deflection":
-        return LoopData(defl, torque / k, {**signals, "displacement": torque / k}, measured_name="deflection_rad",
-                        measured_unit="rad", units=units,
-                        columns={**columns, "displacement": "torque_Nm / k", "measured": "deflection_rad"},
+        return LoopData(defl, torque / k, {**signals, "displacement": torque / k, "torque": torque},
+                        measured_name="deflection_rad", measured_unit="rad", units={**units, "torque": "Nm"},
+                        columns={**columns, "displacement": "torque_Nm / k", "measured": "deflection_rad",
+                                 "torque": "torque_Nm"},
                         gain=1.0, direction="compliance")
     raise LoopInputError(f"predict = '{predict}': use 'torque' (from deflection) or 'deflection' (from torque)")
 
 
-def robot_loop_data(df: pd.DataFrame, spring: dict[str, Any], knee: str = "l") -> LoopData:
-    """LoopData of one knee of a robot recording (`read_recording`, optionally cleaned)."""
+def robot_loop_data(df: pd.DataFrame, spring: dict[str, Any], knee: str = "l",
+                    declared: tuple[str, ...] = ROBOT_DECLARED) -> LoopData:
+    """LoopData of one knee of a robot recording (`read_recording`, optionally cleaned).
+
+    The prediction holds the simulator's gear friction only when `friction` is declared and its
+    backlash only when `dead_band` is; undeclared, they are left for the loop to find.
+    """
     if knee not in KNEE_SIGN:
         raise LoopInputError(f"knee '{knee}' is unknown; use one of {', '.join(KNEE_SIGN)}")
     need = [f"{knee}_{f}" for f in ("knee_pos", "hall_pos", "knee_vel", "knee_eff")] + ["time_s"]
@@ -61,17 +68,21 @@ def robot_loop_data(df: pd.DataFrame, spring: dict[str, Any], knee: str = "l") -
     chain = knee_effects(KneeConfig.from_spring(spring))
     motor, hall = s * df[f"{knee}_knee_pos"].to_numpy(float), s * df[f"{knee}_hall_pos"].to_numpy(float)
     vm, effort = s * df[f"{knee}_knee_vel"].to_numpy(float), s * df[f"{knee}_knee_eff"].to_numpy(float)
-    gear = chain["gear_friction"].apply({"motor_velocity": vm, "effort": np.zeros_like(vm)})
-    spring_defl = (effort - gear) / k
-    backlash = chain["backlash"].values["width_rad"]
+    torque, torque_col = effort, f"{knee}_knee_eff"
+    if "friction" in declared:
+        torque = effort - chain["gear_friction"].apply({"motor_velocity": vm, "effort": np.zeros_like(vm)})
+        torque_col = f"{knee}_knee_eff - gear friction"
+    spring_defl = torque / k
+    backlash = chain["backlash"].values["width_rad"] if "dead_band" in declared else 0.0
     defl = spring_defl + np.sign(spring_defl) * 0.5 * backlash
     return LoopData(
-        hall, motor - defl, {"time": df["time_s"].to_numpy(float), "displacement": spring_defl, "velocity": vm},
+        hall, motor - defl,
+        {"time": df["time_s"].to_numpy(float), "displacement": spring_defl, "velocity": vm, "torque": torque},
         measured_name=f"{knee}_hall_pos", measured_unit="rad",
-        units={"time": "s", "displacement": "rad", "velocity": "rad/s"},
+        units={"time": "s", "displacement": "rad", "velocity": "rad/s", "torque": "Nm"},
         columns={"measured": f"{knee}_hall_pos", "predicted": f"{knee}_knee_pos - deflection({knee}_knee_eff)",
-                 "time": "time_s", "displacement": f"({knee}_knee_eff - gear friction) / k",
-                 "velocity": f"{knee}_knee_vel"},
+                 "time": "time_s", "displacement": f"({torque_col}) / k", "velocity": f"{knee}_knee_vel",
+                 "torque": torque_col},
         path=-defl, gain=-1.0, direction="compliance")
 
 

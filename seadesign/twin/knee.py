@@ -8,7 +8,8 @@ Model per knee (SI units, knee flexion positive; the right knee is mirrored only
 - torque path: deflection qm - angle through the `deflection` effects (gearbox `backlash`,
   `dead_band`), the `spring` and the torque effects -> spring torque;
 - link: J angle'' = spring torque - load torque (`gravity`, `friction`, `ground_contact`
-  in stance), semi-implicit Euler with substeps of at most `max_substep_s`;
+  in stance), semi-implicit Euler with substeps of at most `max_substep_s`; each substep ends
+  with the torques of its new state, so the sampled effort belongs to the sampled angles;
 - sensors at each sample: Hall = link angle through the `hall` effects (noise, 12-bit
   quantisation, ...), motor = qm through `motor` effects, effort = spring torque through the
   `effort` effects (gearbox friction, noise); knee_vel = qm', hall_vel = finite difference of
@@ -222,7 +223,7 @@ class KneeSession:
         self._stages = {t: EffectChain.stage(self._states, t)
                         for t in ("deflection", "torque", "load_torque", "hall", "motor", "effort")}
         sig = self._torques({**base, "angle": self.angle}, 0.0)
-        self.spring_torque = sig["torque"]
+        self.spring_torque, self.load_torque = sig["torque"], sig["load_torque"]
         self._prev_hall: np.ndarray | None = None
         self._t = 0.0
 
@@ -244,16 +245,16 @@ class KneeSession:
         h = self.dt / self.n_sub
         limit, stall, w0 = cfg.torque_limit, cfg.stall_torque_Nm, cfg.no_load_speed_rad_per_s
         inv_j = 1.0 / cfg.link_inertia_kg_m2
-        for _ in range(self.n_sub):
+        for _ in range(self.n_sub):  # torques of the current state move it; then the new state's torques
             u = np.clip(cfg.p_gain_Nm_per_rad * (command_flex - self.qm), -limit, limit)
             self.omega = np.clip(w0 * (u - self.spring_torque) / stall, -w0, w0)
             self.qm = self.qm + self.omega * h
+            self.vel = self.vel + (self.spring_torque - self.load_torque) * inv_j * h
+            self.angle = self.angle + self.vel * h
             self._t += h
             sig = self._torques({"time": np.full_like(self.qm, self._t), "angle": self.angle,
                                  "velocity": self.vel, "stance": stance}, h)
-            self.spring_torque = sig["torque"]
-            self.vel = self.vel + (sig["torque"] - sig["load_torque"]) * inv_j * h
-            self.angle = self.angle + self.vel * h
+            self.spring_torque, self.load_torque = sig["torque"], sig["load_torque"]
 
     def _sense(self) -> Observation:
         t = self._k * self.dt
