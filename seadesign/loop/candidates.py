@@ -165,20 +165,46 @@ def _soften(data: LoopData, path: np.ndarray, factor: np.ndarray) -> np.ndarray:
     return path * factor if data.direction == "stiffness" else path / factor
 
 
-def _thermal(data, th, path, iterations: int = 4):
+def softening_from_compliance(x: np.ndarray, torque: np.ndarray, time: np.ndarray, c: float, tc: float,
+                              chunk: int = 25) -> np.ndarray:
+    """Stiffness factor f per sample when only torque (Nm) and x = torque / k (rad) are known.
+
+    The spring heats by |k d dd| with the true deflection d = x / f, i.e. by q / f^2 with
+    q = |torque dx|, and f = 1 - c H with H the heat (J) cooling with time constant tc (s). H
+    depends on f, which a whole-record fixed point cannot resolve once softening passes a third,
+    so the record is marched in chunks of `chunk` samples with f constant in each, solved
+    implicitly (Newton on f = 1 - c (H_start a^m + S / f^2)); f is floored at 0.05.
+    """
+    a = math.exp(-float(np.median(np.diff(time))) / tc)
+    q = np.abs(torque * np.diff(x, prepend=x[0]))
+    filled = lfilter([1.0], [1.0, -a], q)
+    ends = np.append(np.arange(chunk - 1, x.size - 1, chunk), x.size - 1)
+    per_chunk = np.empty(ends.size)
+    heat, f, prev = 0.0, 1.0, -1
+    for j, e in enumerate(ends):
+        decay = a ** (e - prev)
+        start = heat * decay
+        gained = filled[e] - (decay * filled[prev] if prev >= 0 else 0.0)
+        for _ in range(8):
+            slope = 1.0 - 2.0 * c * gained / f ** 3
+            if slope <= 0.0:  # past the turning point: no stiffness carries this heat, the spring runs away
+                f = 0.05
+                break
+            f = min(max(f - (f - 1.0 + c * (start + gained / f ** 2)) / slope, 0.05), 1.0)
+        heat, prev = start + gained / f ** 2, e
+        per_chunk[j] = f
+    f_chunk = np.repeat(per_chunk, np.diff(np.concatenate([[-1], ends])))
+    return np.maximum(1.0 - c * lfilter([1.0], [1.0, -a], q / f_chunk ** 2), 0.05)
+
+
+def _thermal(data, th, path):
     if "energy" in data.signals:
         return _soften(data, path, np.maximum(1.0 - th[0] * (data.signals["energy"] - data.signals["energy"][0]), 0.05))
     x = data.smooth("displacement")
     if data.direction == "stiffness":
         heat = leaky_sum(np.abs(path * np.diff(x, prepend=x[0])), data.time, th[1])
         return path * np.maximum(1.0 - th[0] * heat, 0.05)
-    # the heat comes from the unsoftened torque k d = torque / f over the true deflection d = x / f,
-    # and f from the heat: a fixed point, from f = 1
-    torque, f = data.smooth("torque"), np.ones_like(x)
-    for _ in range(iterations):
-        d = x / f
-        f = np.maximum(1.0 - th[0] * leaky_sum(np.abs(torque / f * np.diff(d, prepend=d[0])), data.time, th[1]), 0.05)
-    return path / f
+    return path / softening_from_compliance(x, data.smooth("torque"), data.time, th[0], th[1])
 
 
 def _temperature(data, th, path):

@@ -6,7 +6,9 @@ together with the effects already added, it
 1. cuts the held-out RMSE by at least `min_gain` (default 5 %) relative to the current model, and
 2. lowers the training BIC by at least `min_bic_drop` (default 10, "very strong" evidence).
 
-The winner is the accepted candidate with the lowest held-out RMSE. The loop stops when no
+The winner is the accepted candidate with the lowest held-out RMSE, except that a candidate whose
+fitted parameters sit on a search bound (a limit, not an estimate: the effect is being stretched
+to imitate something else) wins only when no accepted candidate fits inside its bounds. The loop stops when no
 candidate is accepted (or after `max_steps`). An effect is therefore only ever named when it
 beats the model without it, and so the plain model, on held-out data. When the final
 residual still fails the whiteness tests, the report says so and where the structure is.
@@ -35,6 +37,7 @@ class TraceEntry:
     bic: float
     aic: float
     accepted: bool
+    at_bound: bool = False
 
 
 @dataclass
@@ -113,9 +116,10 @@ def explain(data: LoopData, declared: Sequence[str] = (), *, min_gain: float = 0
             f = fit(data, current.keys + (key,), held, warm)
             h = f.errors["held_out"]["rmse"]
             ok = h <= (1.0 - min_gain) * base_h and f.bic <= current.bic - min_bic_drop
-            trace.append(TraceEntry(key, f, h, f.bic, f.aic, ok))
+            pinned = any(p["at_bound"] for p in f.parameters()[key].values())
+            trace.append(TraceEntry(key, f, h, f.bic, f.aic, ok, pinned))
         trace.sort(key=lambda t: t.held_out_rmse)
-        winners = [t for t in trace if t.accepted]
+        winners = sorted((t for t in trace if t.accepted), key=lambda t: t.at_bound)  # stable: RMSE order kept
         if not winners:
             break
         best = winners[0]

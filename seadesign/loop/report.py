@@ -14,8 +14,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from seadesign.loop.engine import Explanation  # noqa: E402
+from seadesign.loop.engine import Explanation, TraceEntry  # noqa: E402
 
+
+
+def _trace_row(t: TraceEntry) -> dict:
+    return {"effect": t.effect, "held_out_rmse": t.held_out_rmse, "bic": t.bic, "aic": t.aic,
+            "accepted": t.accepted, "at_bound": t.at_bound}
 
 def _errors(e: dict) -> dict:
     return {part: {k: float(v) for k, v in m.items()} for part, m in e.items()}
@@ -36,12 +41,10 @@ def to_json(ex: Explanation, title: str) -> dict[str, Any]:
             {"effect": s.effect, "parameters": s.after.parameters(),
              "errors_before": _errors(s.before.errors), "errors_after": _errors(s.after.errors),
              "bic_before": s.before.bic, "bic_after": s.after.bic,
-             "trace": [{"effect": t.effect, "held_out_rmse": t.held_out_rmse, "bic": t.bic, "aic": t.aic,
-                        "accepted": t.accepted} for t in s.trace]}
+             "trace": [_trace_row(t) for t in s.trace]}
             for s in ex.steps
         ],
-        "last_trace": [{"effect": t.effect, "held_out_rmse": t.held_out_rmse, "bic": t.bic, "aic": t.aic,
-                        "accepted": t.accepted} for t in ex.last_trace],
+        "last_trace": [_trace_row(t) for t in ex.last_trace],
         "final": {"effects": ex.found, "parameters": ex.final.parameters(), "errors": _errors(ex.final.errors)},
         "residual_tests_before": ex.tests_before,
         "residual_tests": ex.tests_after,
@@ -128,10 +131,10 @@ def markdown(report: dict[str, Any], images: list[Path]) -> str:
             for name, p in ps.items():
                 bound = " (at search bound)" if p["at_bound"] else ""
                 lines.append(f"| {eff} | {name} | {_fmt(p['value'])}{bound} | {_fmt(p['uncertainty'])} | {p['unit']} |")
-        lines += ["", f"Candidates tried (held-out RMSE {u}, BIC):", "", "| candidate | held-out RMSE | BIC | accepted |",
-                  "|---|---|---|---|"]
-        lines += [f"| {t['effect']} | {_fmt(t['held_out_rmse'])} | {t['bic']:.1f} | {'yes' if t['accepted'] else 'no'} |"
-                  for t in s["trace"]]
+        lines += ["", f"Candidates tried (held-out RMSE {u}, BIC):", "",
+                  "| candidate | held-out RMSE | BIC | accepted | parameter at search bound |", "|---|---|---|---|---|"]
+        lines += [f"| {t['effect']} | {_fmt(t['held_out_rmse'])} | {t['bic']:.1f} | {'yes' if t['accepted'] else 'no'} "
+                  f"| {'yes' if t['at_bound'] else 'no'} |" for t in s["trace"]]
     if report["last_trace"]:
         lines += ["", "## Last trace (nothing accepted)", "", "| candidate | held-out RMSE | BIC |", "|---|---|---|"]
         lines += [f"| {t['effect']} | {_fmt(t['held_out_rmse'])} | {t['bic']:.1f} |" for t in report["last_trace"]]
