@@ -188,3 +188,17 @@ def test_compliance_softening_matches_the_effect_library(c, softest, rtol):
     truth = torque[moving] / (K * d[moving])
     assert truth.min() < softest  # the case softens as stated
     np.testing.assert_allclose(f[moving], truth, rtol=rtol)
+
+
+@pytest.mark.parametrize("torque, stiffness", [(0.3, 50.0), (0.03, 500.0), (0.0066, 30.0), (1.0, 0.5)])
+def test_vectorised_dahl_equals_the_effect_library(torque, stiffness):
+    """The loop's block-wise Dahl solution against the library's per-sample recursion, on a sine with a
+    random walk (many small reversals), from slow to instant saturation."""
+    from seadesign.effects import DahlHysteresis
+    from seadesign.loop.candidates import dahl
+
+    t = np.arange(20000) / 100.0
+    d = 0.5 * np.sin(2 * np.pi * 0.3 * t) + np.cumsum(np.random.default_rng(0).normal(0, 0.003, t.size))
+    ref = DahlHysteresis().apply({"deflection": d, "torque": np.zeros_like(d)},
+                                 {"torque_Nm": torque, "stiffness_Nm_per_rad": stiffness})
+    np.testing.assert_allclose(dahl(d, torque, stiffness), ref, rtol=0, atol=1e-12 * torque)

@@ -102,27 +102,26 @@ def _cubic(data, th, path):
     return path + _g(data) * (solve_cubic(x, th[0]) - x)  # k d + k3 d^3 = k x, th[0] = k3 / k
 
 
-def dahl(d: np.ndarray, torque: float, stiffness: float, chunk: float = 500.0) -> np.ndarray:
+def dahl(d: np.ndarray, torque: float, stiffness: float, block: int = 16) -> np.ndarray:
     """Dahl hysteresis torque z (unit of `torque`) along a displacement record, vectorised.
 
     The same recursion as `seadesign.effects.DahlHysteresis` (z_n = a_n z_{n-1} + (1 - a_n) s_n tau_h,
-    a_n = exp(-sigma |dd_n| / tau_h)), solved in closed form over chunks in which the decay
-    exponent grows by at most `chunk`, so the exponentials stay finite (at most one chunk per sample).
+    a_n = exp(-sigma |dd_n| / tau_h)), solved in closed form within blocks of `block` samples
+    (all blocks at once) and carried from block to block. Each sample's decay exponent is capped
+    at 40 (a_n < 5e-18 either way), so a block's exponents stay below 640 and finite.
     """
+    n = d.size
     step = np.diff(d, prepend=d[0])
-    c = stiffness / torque
-    decay = np.abs(step) * c
-    v = np.cumsum(decay)
+    decay = np.abs(step) * (stiffness / torque)
     b = np.sign(step) * torque * -np.expm1(-decay)
-    z = np.empty_like(v)
-    ids = np.floor(v / chunk)
-    starts = np.flatnonzero(np.diff(ids, prepend=-1.0))
-    z_prev = 0.0
-    for i0, i1 in zip(starts, [*starts[1:], v.size]):
-        r = v[i0:i1] - v[i0]
-        z[i0:i1] = np.exp(-r) * (z_prev * math.exp(-decay[i0]) + np.cumsum(b[i0:i1] * np.exp(r)))
-        z_prev = z[i1 - 1]
-    return z
+    pad = -n % block
+    v = np.cumsum(np.pad(np.minimum(decay, 40.0), (0, pad)).reshape(-1, block), axis=1)
+    local = np.exp(-v) * np.cumsum(np.pad(b, (0, pad)).reshape(-1, block) * np.exp(v), axis=1)
+    carry, into = 0.0, []
+    for end, fade in zip(local[:, -1].tolist(), np.exp(-v[:, -1]).tolist()):
+        into.append(carry)
+        carry = end + carry * fade
+    return (local + np.asarray(into)[:, None] * np.exp(-v)).ravel()[:n]
 
 
 def _add(data: LoopData, path: np.ndarray, term: np.ndarray) -> np.ndarray:
@@ -190,7 +189,10 @@ def softening_from_compliance(x: np.ndarray, torque: np.ndarray, time: np.ndarra
             if slope <= 0.0:  # past the turning point: no stiffness carries this heat, the spring runs away
                 f = 0.05
                 break
-            f = min(max(f - (f - 1.0 + c * (start + gained / f ** 2)) / slope, 0.05), 1.0)
+            change = (f - 1.0 + c * (start + gained / f ** 2)) / slope
+            f = min(max(f - change, 0.05), 1.0)
+            if abs(change) < 1e-12:
+                break
         heat, prev = start + gained / f ** 2, e
         per_chunk[j] = f
     f_chunk = np.repeat(per_chunk, np.diff(np.concatenate([[-1], ends])))
