@@ -77,7 +77,7 @@ class ArtefactReport:
                 f"    Hall offset at first rest: {_fmt(off['first_rest_rad'])} rad "
                 f"(foot load {_fmt(off['first_rest_pressure'])}); all rest: {_fmt(off['rest_median_rad'])} rad "
                 f"over {off['rest_samples']} samples; drift {_fmt(off['drift_rad_per_min'])} rad/min",
-                f"    offset per stretch between jumps: "
+                "    offset per stretch between jumps: "
                 + ", ".join(f"from {g['start_s']:.2f} s {_fmt(g['offset_rad'])}" for g in off["segments"]),
                 f"    wrap-arounds: {len(k['wraps'])}; steps: {len(k['steps'])}"
                 + "".join(f" [t={e['time_s']:.2f} s {e['size_rad']:+.3f} rad]" for e in k["steps"][:6])

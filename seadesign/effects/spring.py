@@ -7,7 +7,6 @@ Order in a chain: dead zones act on `deflection` first, then `LinearSpring` turn
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
