@@ -12,7 +12,7 @@ models are those of the shared effect library (`seadesign.effects`) where its fo
 fit: dead-band, temperature softening and gravity call the library's effect
 objects. The rest are written here because the fit needs what the library does not offer:
 signed coefficients (friction, offset, drift, a measured-side delay of either sign), Dahl hysteresis solved
-in closed form over chunks instead of a per-sample Python loop (`dahl`, equal to the library's), a
+in closed form over blocks of samples instead of a per-sample Python loop (`dahl`, equal to the library's), a
 vectorised standard-linear-solid lag (`scipy.signal.lfilter` at the median sample interval)
 and thermal softening driven by dissipated energy with one identifiable gain (1/J, the
 library's softening_per_K x loss_factor / heat_capacity).
