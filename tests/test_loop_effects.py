@@ -183,7 +183,7 @@ def test_compliance_softening_matches_the_effect_library(c, softest, rtol):
     torque = ThermalSoftening().apply({"deflection": d, "torque": K * d, "time": t},
                                       {"softening_per_K": c, "loss_factor": 1.0, "heat_capacity_J_per_K": 1.0,
                                        "cooling_time_s": 300.0})
-    f = softening_from_compliance(torque / K, torque, t, c, 300.0)
+    f = softening_from_compliance(torque / K, torque, 0.01, c, 300.0)
     moving = np.abs(d) > 0.1
     truth = torque[moving] / (K * d[moving])
     assert truth.min() < softest  # the case softens as stated

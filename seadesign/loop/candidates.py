@@ -135,9 +135,9 @@ def _hysteresis(data, th, path):
     return _add(data, path, dahl(data.smooth("displacement"), th[0], th[1]))
 
 
-def lowpass_uniform(x: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
-    """First-order lag of x with time constant tau (s) at the median sample interval, starting at x[0]."""
-    a = math.exp(-float(np.median(np.diff(time))) / tau)
+def lowpass_uniform(x: np.ndarray, dt: float, tau: float) -> np.ndarray:
+    """First-order lag of x with time constant tau (s) at sample interval dt (s), starting at x[0]."""
+    a = math.exp(-dt / tau)
     y, _ = lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])
     return y
 
@@ -145,17 +145,17 @@ def lowpass_uniform(x: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
 def _viscoelastic(data, th, path):
     x = data.smooth("displacement")
     if data.direction == "stiffness":
-        return path + th[0] * (x - lowpass_uniform(x, data.time, th[1]))
+        return path + th[0] * (x - lowpass_uniform(x, data.dt, th[1]))
     # x = torque / k = d + r (d - lowpass(d)), r = k2 / k: invert the filter for the deflection d
-    r, a = th[0], math.exp(-float(np.median(np.diff(data.time))) / th[1])
+    r, a = th[0], math.exp(-data.dt / th[1])
     b, den = [1.0, -a], [1.0 + r * a, -a * (1.0 + r)]
     d, _ = lfilter(b, den, x, zi=lfilter_zi(b, den) * x[0])
     return path + _g(data) * (d - x)
 
 
-def leaky_sum(h: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
-    """s_n = s_{n-1} exp(-dt/tau) + h_n at the median sample interval (heat with cooling)."""
-    a = math.exp(-float(np.median(np.diff(time))) / tau)
+def leaky_sum(h: np.ndarray, dt: float, tau: float) -> np.ndarray:
+    """s_n = s_{n-1} exp(-dt/tau) + h_n at sample interval dt (s): heat with cooling time tau (s)."""
+    a = math.exp(-dt / tau)
     return lfilter([1.0], [1.0, -a], h)
 
 
@@ -164,7 +164,7 @@ def _soften(data: LoopData, path: np.ndarray, factor: np.ndarray) -> np.ndarray:
     return path * factor if data.direction == "stiffness" else path / factor
 
 
-def softening_from_compliance(x: np.ndarray, torque: np.ndarray, time: np.ndarray, c: float, tc: float,
+def softening_from_compliance(x: np.ndarray, torque: np.ndarray, dt: float, c: float, tc: float,
                               chunk: int = 25) -> np.ndarray:
     """Stiffness factor f per sample when only torque (Nm) and x = torque / k (rad) are known.
 
@@ -174,7 +174,7 @@ def softening_from_compliance(x: np.ndarray, torque: np.ndarray, time: np.ndarra
     so the record is marched in chunks of `chunk` samples with f constant in each, solved
     implicitly (Newton on f = 1 - c (H_start a^m + S / f^2)); f is floored at 0.05.
     """
-    a = math.exp(-float(np.median(np.diff(time))) / tc)
+    a = math.exp(-dt / tc)
     q = np.abs(torque * np.diff(x, prepend=x[0]))
     filled = lfilter([1.0], [1.0, -a], q)
     ends = np.append(np.arange(chunk - 1, x.size - 1, chunk), x.size - 1)
@@ -204,9 +204,9 @@ def _thermal(data, th, path):
         return _soften(data, path, np.maximum(1.0 - th[0] * (data.signals["energy"] - data.signals["energy"][0]), 0.05))
     x = data.smooth("displacement")
     if data.direction == "stiffness":
-        heat = leaky_sum(np.abs(path * np.diff(x, prepend=x[0])), data.time, th[1])
+        heat = leaky_sum(np.abs(path * np.diff(x, prepend=x[0])), data.dt, th[1])
         return path * np.maximum(1.0 - th[0] * heat, 0.05)
-    return path / softening_from_compliance(x, data.smooth("torque"), data.time, th[0], th[1])
+    return path / softening_from_compliance(x, data.smooth("torque"), data.dt, th[0], th[1])
 
 
 def _temperature(data, th, path):

@@ -97,6 +97,13 @@ class LoopData:
         return self.__dict__[key]
 
     @property
+    def dt(self) -> float:
+        """Median sample interval (s), cached: the step of the candidates' uniform-rate filters."""
+        if "_dt" not in self.__dict__:
+            self.__dict__["_dt"] = float(np.median(np.diff(self.time)))
+        return self.__dict__["_dt"]
+
+    @property
     def n(self) -> int:
         return self.measured.size
 
