@@ -18,11 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
-from seadesign.candidates import check_candidate, find_candidate
+from seadesign.design.candidate import check_candidate, find_candidate
 from seadesign.fea.ccx import run_ccx, write_load_case_decks
 from seadesign.fea.loadcases import analyse
 from seadesign.mesh import mesh_part
-from seadesign.study import load_study
+from seadesign.design.study import load_study
 
 
 def main() -> None:

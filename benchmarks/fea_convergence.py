@@ -21,12 +21,12 @@ import time
 
 import numpy as np
 
-from seadesign.candidates import check_candidate, find_candidate
+from seadesign.design.candidate import check_candidate, find_candidate
 from seadesign.fea.convergence import richardson
 from seadesign.fea.loadcases import analyse
 from seadesign.mesh import mesh_part
-from seadesign.stages import COARSENING, CONVERGENCE_ORDER
-from seadesign.study import load_study
+from seadesign.sweep.stages import COARSENING, CONVERGENCE_ORDER
+from seadesign.design.study import load_study
 
 
 def k_at(st, part, width, refinement, backend, cache_dir) -> tuple[float, float, int, float]:

@@ -50,6 +50,6 @@ def spring_dict() -> dict:
 @pytest.fixture
 def spring_file(tmp_path, spring_dict) -> Path:
     """spring_dict written to a file through the validating writer."""
-    from seadesign.handoff import write_spring
+    from seadesign.design.spring import write_spring
 
     return write_spring(spring_dict, tmp_path / "spring.json")

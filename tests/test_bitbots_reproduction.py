@@ -5,9 +5,9 @@ import pytest
 import trimesh
 
 from conftest import shared_path
-from seadesign.candidates import check_candidate
-from seadesign.export import tessellate
-from seadesign.study import load_study
+from seadesign.design.candidate import check_candidate
+from seadesign.design.export import tessellate
+from seadesign.design.study import load_study
 
 
 def _surface_distances(a: trimesh.Trimesh, b: trimesh.Trimesh, n: int, seed: int) -> np.ndarray:

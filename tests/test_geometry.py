@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 import trimesh
 
-from seadesign.candidates import check_candidate
-from seadesign.export import write_step, write_stl
-from seadesign.geometry import build_part
-from seadesign.params import BoltPattern, GeometryParams
-from seadesign.study import load_study
-from seadesign.validity import check
+from seadesign.design.candidate import check_candidate
+from seadesign.design.export import write_step, write_stl
+from seadesign.design.geometry import build_part
+from seadesign.design.params import BoltPattern, GeometryParams
+from seadesign.design.study import load_study
+from seadesign.design.validity import check
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from seadesign.errors import SpringFileError
-from seadesign.handoff import load_spring, validate_spring, write_spring
+from seadesign.design.spring import load_spring, validate_spring, write_spring
 
 
 def test_valid_spring_round_trips(spring_file, spring_dict):

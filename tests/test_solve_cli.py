@@ -9,7 +9,7 @@ import pytest
 from click.testing import CliRunner
 
 from seadesign.cli import main
-from seadesign.study import load_study
+from seadesign.design.study import load_study
 from sweep_helpers import write_tiny_study
 
 

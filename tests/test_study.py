@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from seadesign.errors import ConfigError
-from seadesign.study import DEFAULT_STUDY, load_study
+from seadesign.design.study import DEFAULT_STUDY, load_study
 
 
 def test_default_study():

@@ -9,12 +9,12 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from seadesign.cache import Cache
+from seadesign.run.cache import Cache
 from seadesign.cli import main
 from seadesign.errors import MeshError, SpringFileError
-from seadesign.handoff import load_spring, validate_spring
-from seadesign.study import load_study
-from seadesign.sweep import run_sweep
+from seadesign.design.spring import load_spring, validate_spring
+from seadesign.design.study import load_study
+from seadesign.sweep.runner import run_sweep
 from sweep_helpers import write_tiny_study
 
 
@@ -141,7 +141,7 @@ def test_warm_rerun_keeps_unchanged_outputs_and_redraws_changed_ones(tiny, tmp_p
 
 
 def test_failing_candidate_is_recorded_and_the_sweep_goes_on(tmp_path, monkeypatch):
-    import seadesign.stages as stages
+    import seadesign.sweep.stages as stages
 
     def broken(study, params, checked, cache):
         raise MeshError("mesher gave up (test)")

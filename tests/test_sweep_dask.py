@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from seadesign.cache import Cache
-from seadesign.progress import ProgressDisplay
-from seadesign.study import load_study
-from seadesign.sweep import run_sweep
+from seadesign.run.cache import Cache
+from seadesign.run.progress import ProgressDisplay
+from seadesign.design.study import load_study
+from seadesign.sweep.runner import run_sweep
 from sweep_helpers import write_tiny_study
 
 pytest.importorskip("distributed")

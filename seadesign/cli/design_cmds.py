@@ -6,10 +6,10 @@ from pathlib import Path
 
 import click
 
-from seadesign.candidates import check_candidate, find_candidate
+from seadesign.design.candidate import check_candidate, find_candidate
 from seadesign.cli import main
-from seadesign.export import export_candidate
-from seadesign.study import DEFAULT_STUDY, load_study
+from seadesign.design.export import export_candidate
+from seadesign.design.study import DEFAULT_STUDY, load_study
 
 STUDY_ARG = click.argument("study", default=str(DEFAULT_STUDY.stem), required=False)
 OUT_OPT = click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=Path("exports"),

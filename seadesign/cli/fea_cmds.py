@@ -61,8 +61,8 @@ def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs
     Either STUDY --beams N --thickness-mm T (a candidate of a study), or --stl FILE --beam-width-mm W.
     """
     from seadesign.fea.solve_part import solve_part
-    from seadesign.materials import load_material
-    from seadesign.study import load_study
+    from seadesign.design.materials import load_material
+    from seadesign.design.study import load_study
 
     if (stl is None) == (study is None):
         raise ConfigError("give either a STUDY (with --beams and --thickness-mm) or --stl FILE, not both or neither")
@@ -83,7 +83,7 @@ def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs
     else:
         if beams is None or thickness_mm is None:
             raise ConfigError("the study form needs --beams N and --thickness-mm T")
-        from seadesign.candidates import check_candidate, find_candidate
+        from seadesign.design.candidate import check_candidate, find_candidate
 
         checked = check_candidate(st, find_candidate(st, beams, thickness_mm))
         if not checked.valid:

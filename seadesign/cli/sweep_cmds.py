@@ -11,7 +11,7 @@ import click
 
 from seadesign.cli import main
 from seadesign.errors import ConfigError
-from seadesign.study import DEFAULT_STUDY, Study, load_study
+from seadesign.design.study import DEFAULT_STUDY, Study, load_study
 
 
 CALIBRATION_KEYS = ("youngs_modulus_fitted_Pa", "youngs_modulus_Pa", "stiffness_scale")
@@ -66,11 +66,11 @@ def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: s
     Interrupted sweeps resume; unchanged stages come from the cache. Units: lengths mm where
     named, otherwise SI (N, Nm, rad, Pa).
     """
-    from seadesign.cache import DEFAULT_CACHE_DIR, Cache
-    from seadesign.rank import calibration_summary, rank
+    from seadesign.run.cache import DEFAULT_CACHE_DIR, Cache
+    from seadesign.sweep.rank import calibration_summary, rank
     from seadesign.report import write_outputs
-    from seadesign.stages import SolverSettings
-    from seadesign.sweep import run_sweep, sweep_settings
+    from seadesign.sweep.stages import SolverSettings
+    from seadesign.sweep.runner import run_sweep, sweep_settings
 
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
     s = load_study(study)

@@ -9,7 +9,7 @@ from seadesign.fea.ccx import write_load_case_decks
 from seadesign.fea.export import write_results_json, write_vtu
 from seadesign.fea.loadcases import Analysis, analyse
 from seadesign.mesh import TetMesh, mesh_part
-from seadesign.part import Interfaces
+from seadesign.design.interfaces import Interfaces
 
 
 def solve_part(

@@ -19,7 +19,7 @@ from seadesign.mesh import cache
 from seadesign.mesh.extrude import layer_count
 from seadesign.mesh.surface import load_stl, tessellate_solid
 from seadesign.mesh.tetmesh import MeshQuality, TetMesh, build_tetmesh
-from seadesign.part import Interfaces
+from seadesign.design.interfaces import Interfaces
 
 __all__ = ["BACKENDS", "MeshQuality", "TetMesh", "load_stl", "mesh_part"]
 

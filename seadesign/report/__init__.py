@@ -10,13 +10,13 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from seadesign.cache import Cache, digest
-from seadesign.handoff import write_spring
-from seadesign.rank import Choice
+from seadesign.run.cache import Cache, digest
+from seadesign.design.spring import write_spring
+from seadesign.sweep.rank import Choice
 from seadesign.report.document import write_html, write_markdown
-from seadesign.report.handoff import spring_document
-from seadesign.stages import SolverSettings, fea_key, geometry_key
-from seadesign.study import Study
+from seadesign.sweep.handoff import spring_document
+from seadesign.sweep.stages import SolverSettings, fea_key, geometry_key
+from seadesign.design.study import Study
 
 log = logging.getLogger(__name__)
 
@@ -61,8 +61,8 @@ def export_cad(study: Study, rows: pd.DataFrame, folder: Path, tolerance_mm: flo
         files = [folder / f"{stem}.stl", folder / f"{stem}.step"]
         key = digest(geometry_key(study, params), tolerance_mm)
         if not up_to_date(files, key):
-            from seadesign.candidates import check_candidate  # CadQuery: only when a file is (re)written
-            from seadesign.export import export_candidate
+            from seadesign.design.candidate import check_candidate  # CadQuery: only when a file is (re)written
+            from seadesign.design.export import export_candidate
 
             export_candidate(check_candidate(study, params), folder, tolerance_mm)
             stamp(files, key)

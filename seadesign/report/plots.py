@@ -11,7 +11,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from seadesign.rank import ACCURACY, PROTECTION  # noqa: E402
+from seadesign.sweep.rank import ACCURACY, PROTECTION  # noqa: E402
 
 
 def _by_thickness(t: pd.DataFrame):

@@ -36,7 +36,7 @@ from seadesign import __version__
 from seadesign.data.robot import COMMAND_COLUMNS, IMU_COLUMNS, KNEE_SIGN, PRESSURE_COLUMNS, RECORDING_COLUMNS
 from seadesign.effects import EffectChain, effect_rng
 from seadesign.errors import ConfigError
-from seadesign.handoff import load_spring
+from seadesign.design.spring import load_spring
 from seadesign.twin.config import KneeConfig, knee_effects
 from seadesign.twin.walk import Gait, Trial, knee_targets
 

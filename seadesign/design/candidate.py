@@ -5,10 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from seadesign.errors import ConfigError
-from seadesign.geometry import Part, build_part
-from seadesign.params import GeometryParams
-from seadesign.study import Study
-from seadesign.validity import check
+from seadesign.design.geometry import Part, build_part
+from seadesign.design.params import GeometryParams
+from seadesign.design.study import Study
+from seadesign.design.validity import check
 
 
 @dataclass

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from seadesign.part import Hole, Interfaces
+from seadesign.design.interfaces import Hole, Interfaces
 
 
 @dataclass(frozen=True)

@@ -13,8 +13,8 @@ import cadquery as cq
 import numpy as np
 from shapely.geometry import Point, Polygon
 
-from seadesign.geometry import Part
-from seadesign.params import ValidityRules
+from seadesign.design.geometry import Part
+from seadesign.design.params import ValidityRules
 
 
 def _wire_polygon(wire: cq.Wire, step_mm: float = 0.05) -> np.ndarray:

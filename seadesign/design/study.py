@@ -12,11 +12,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from seadesign.errors import ConfigError
-from seadesign.materials import Material, load_material
-from seadesign.params import BoltPattern, GeometryParams, NutSlots, ValidityRules
-from seadesign.tomlcheck import Table, find_toml, read_toml
+from seadesign.design.materials import Material, load_material
+from seadesign.design.params import BoltPattern, GeometryParams, NutSlots, ValidityRules
+from seadesign.design.tomlcheck import Table, find_toml, read_toml
 
-STUDIES_DIR = Path(__file__).resolve().parents[1] / "studies"
+STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
 DEFAULT_STUDY = STUDIES_DIR / "wolfgang_knee.toml"
 G = 9.80665  # m/s^2
 

@@ -20,12 +20,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from seadesign.cache import Cache, digest, package_versions
-from seadesign.executors import default_jobs, execute
-from seadesign.params import GeometryParams
-from seadesign.progress import ProgressDisplay
-from seadesign.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key, load_case_columns
-from seadesign.study import Study
+from seadesign.run.cache import Cache, digest, package_versions
+from seadesign.run.executors import default_jobs, execute
+from seadesign.design.params import GeometryParams
+from seadesign.run.progress import ProgressDisplay
+from seadesign.sweep.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key, load_case_columns
+from seadesign.design.study import Study
 
 
 @dataclass(frozen=True)

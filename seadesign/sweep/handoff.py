@@ -7,8 +7,8 @@ import math
 
 import pandas as pd
 
-from seadesign.handoff import SCHEMA_VERSION
-from seadesign.study import Study
+from seadesign.design.spring import SCHEMA_VERSION
+from seadesign.design.study import Study
 
 EXTRAPOLATION_NOTE = (
     "linear FEA; beyond {limit:g} rad the beams' rotations are no longer small (sin x ~ x within 0.2 %), "

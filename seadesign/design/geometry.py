@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import cadquery as cq
 
-from seadesign.params import GeometryParams
-from seadesign.part import Interfaces
+from seadesign.design.params import GeometryParams
+from seadesign.design.interfaces import Interfaces
 
 
 @dataclass

@@ -21,7 +21,7 @@ SCHEMA_VERSION = 1
 
 def spring_schema() -> dict[str, Any]:
     """The JSON Schema of spring.json."""
-    text = resources.files("seadesign").joinpath("schemas/spring.schema.json").read_text()
+    text = resources.files("seadesign.design").joinpath("schemas/spring.schema.json").read_text()
     return json.loads(text)
 
 
@@ -38,7 +38,7 @@ def validate_spring(data: Any, source: str = "spring.json") -> dict[str, Any]:
             field = "/".join(path) or "(top level)"
             lines.append(f"  field '{field}': {err.message}")
         raise SpringFileError(
-            f"{source} does not match the spring.json schema (seadesign/schemas/spring.schema.json):\n"
+            f"{source} does not match the spring.json schema (seadesign/design/schemas/spring.schema.json):\n"
             + "\n".join(lines)
             + "\nRegenerate it with `seadesign sweep` or fix the listed fields."
         )

@@ -21,9 +21,9 @@ from typing import Callable
 
 import numpy as np
 
-from seadesign.cache import Cache, digest, package_versions
-from seadesign.params import GeometryParams
-from seadesign.study import Study
+from seadesign.run.cache import Cache, digest, package_versions
+from seadesign.design.params import GeometryParams
+from seadesign.design.study import Study
 
 Progress = Callable[[str], None]  # receives the name of the stage that starts
 COARSENING = 1.5  # edge-length ratio of the error-estimate mesh to the result mesh
@@ -85,7 +85,7 @@ def check_geometry(study: Study, params: GeometryParams, cache: Cache) -> tuple[
     hit = cache.get("geometry", key)
     if hit is not None:
         return hit, None
-    from seadesign.candidates import check_candidate
+    from seadesign.design.candidate import check_candidate
 
     checked = check_candidate(study, params)
     geo = Geometry(tuple(checked.reasons), float(checked.part.volume_mm3))
@@ -174,7 +174,7 @@ def fea_response(study: Study, params: GeometryParams, checked, settings: Solver
     if unit is not None:
         return unit
     if checked is None:
-        from seadesign.candidates import check_candidate
+        from seadesign.design.candidate import check_candidate
 
         progress("geometry")
         checked = check_candidate(study, params)

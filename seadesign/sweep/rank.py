@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from seadesign.study import Study
+from seadesign.design.study import Study
 
 # Thesis NASTRAN results (Stelter 2022, fig. 5.3/5.4) for the candidates it reports numerically:
 # (beams, thickness mm) -> (peak reaction force N, stall bearing displacement mm).
