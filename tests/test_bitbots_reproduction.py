@@ -5,7 +5,6 @@ import pytest
 import trimesh
 
 from conftest import shared_path
-from seadesign.design.candidate import check_candidate
 from seadesign.design.export import tessellate
 from seadesign.design.study import load_study
 
@@ -23,10 +22,10 @@ def test_bitbots_part_is_reproduced():
     # the file's axis is Y: rotate +90 deg about x so it becomes +z (x, y, z -> x, -z, y), no mirroring
     stl.vertices = np.c_[stl.vertices[:, 0], -stl.vertices[:, 2], stl.vertices[:, 1]]
     study = load_study("bitbots_shoulder")
-    c = check_candidate(study, study.candidates()[0])
+    c, part = study.check(study.candidates()[0])
     assert c.valid, c.reasons
-    ours = tessellate(c.part.solid, tolerance_mm=0.01)
-    assert c.part.volume_mm3 == pytest.approx(stl.volume, rel=0.02)
+    ours = tessellate(part.solid, tolerance_mm=0.01)
+    assert c.volume_mm3 == pytest.approx(stl.volume, rel=0.02)
     assert ours.volume == pytest.approx(stl.volume, rel=0.02)
     d = np.concatenate([_surface_distances(ours, stl, 20000, 1), _surface_distances(stl, ours, 20000, 2)])
     assert d.mean() < 0.3  # mm, symmetric mean surface distance

@@ -52,7 +52,7 @@ def test_peak_shear_and_l2_projection(mesh):
 
 def test_load_cases_on_annulus(mesh):
     torque = 2.0
-    res = analyse(mesh, E, NU, 4e6, stall_torque_Nm=torque, impact_torque_Nm=3.0, bearing_radius_mm=A).results
+    res = analyse(mesh, E, NU, 4e6, stall_torque_Nm=torque, impact_torque_Nm=3.0, bearing_radius_mm=A).results.columns()
     k = annulus_k_Nm_per_rad(A, B, H, E, NU)
     assert res["k_Nm_per_rad"] == pytest.approx(k, rel=0.01)
     assert res["stall_rotation_rad"] == pytest.approx(torque / k, rel=0.01)

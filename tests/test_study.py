@@ -14,19 +14,19 @@ def test_default_study():
     s = load_study()
     assert s.name == "wolfgang_knee"
     assert len(s.candidates()) == 24
-    assert {(c.beam_count, c.beam_thickness_mm) for c in s.candidates()} == {
+    assert {(c.params.beam_count, c.params.beam_thickness_mm) for c in s.candidates()} == {
         (n, t) for n in range(3, 11) for t in (4.0, 6.0, 8.0)}
     # thesis eq. 5.1: tau = r F sin(theta) = 0.2038 m * 4 * 39.23 N * sin 60 deg = 27.70 Nm
     assert s.load_cases.impact_torque_Nm == pytest.approx(0.2038 * 4 * 39.23 * math.sin(math.pi / 3))
     assert round(s.load_cases.impact_torque_Nm, 2) == 27.70
-    assert s.base["hub_radius_mm"] == 14.0
-    hub = s.base["hub_bolts"]
+    assert all(c.params.hub_radius_mm == 14.0 for c in s.candidates())
+    hub = s.candidates()[0].params.hub_bolts
     assert (hub.count, hub.circle_diameter_mm) == (8, 22.0)
 
 
 def test_bitbots_study_loads():
     s = load_study("bitbots_shoulder")
-    (p,) = s.candidates()
+    ((_, p),) = [(c, c.params) for c in s.candidates()]
     assert (p.beam_count, p.beam_thickness_mm, p.ring_outer_radius_mm) == (6, 3.0, 25.0)
 
 

@@ -35,7 +35,7 @@ def test_outputs_exist_and_choice_is_the_valid_candidate(tiny):
     _, _, out = tiny
     folder = out / "tiny"
     for name in ("results.parquet", "results.csv", "settings.json", "report.html", "report.md", "spring.json",
-                 "reaction_displacement.png", "k_vs_beams.png", "pareto.png", "3beams_8mm.stl", "3beams_8mm.step"):
+                 "reaction_displacement.png", "k_vs_beam_count.png", "pareto.png", "3beams_8mm.stl", "3beams_8mm.step"):
         assert (folder / name).is_file(), name
     t = pd.read_csv(folder / "results.csv")
     assert len(t) == 2
@@ -119,7 +119,7 @@ def test_modulus_change_resolves_on_the_cached_mesh(tiny, tmp_path):
 def test_warm_rerun_keeps_unchanged_outputs_and_redraws_changed_ones(tiny, tmp_path):
     study_path, cache_dir, out = tiny
     folder = out / "tiny"
-    kept = ["pareto.png", "k_vs_beams.png", "reaction_displacement.png", "3beams_8mm.stl", "3beams_8mm.step"]
+    kept = ["pareto.png", "k_vs_beam_count.png", "reaction_displacement.png", "3beams_8mm.stl", "3beams_8mm.step"]
     before = {n: (folder / n).stat().st_mtime_ns for n in kept}
     args = ["sweep", str(study_path), "--jobs", "1", "--quiet", "--out", str(out), "--cache-dir", str(cache_dir)]
     assert CliRunner().invoke(main, args).exit_code == 0

@@ -1,46 +1,65 @@
-"""Build and check every candidate of a study: the geometry stage of the sweep."""
+"""The candidate: one point of a study's design space, and its checked geometry.
+
+A `Candidate` carries the design-axis values that name it and the full geometry they give. Once
+checked (`check_candidate`, or `with_geometry` from a cached verdict) it also carries its validity
+reasons, volume (mm^3) and mass (kg). The CadQuery `Part` is returned beside it, not inside: it
+is needed only to mesh and export, and it does not pickle.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
-from seadesign.errors import ConfigError
-from seadesign.design.geometry import Part, build_part
-from seadesign.design.params import GeometryParams
-from seadesign.design.study import Study
-from seadesign.design.validity import check
+from seadesign.design.params import GeometryParams, ValidityRules
+from seadesign.design.space import Value, candidate_name, file_stem
+
+if TYPE_CHECKING:
+    from seadesign.design.geometry import Part
 
 
-@dataclass
-class CheckedPart:
-    """A built candidate with its validity verdict, volume (mm^3) and mass (kg)."""
+@dataclass(frozen=True)
+class Candidate:
+    """Design-axis values (key, value) in the study's axis order, the geometry they give, and,
+    once checked, the validity reasons (empty: valid), volume (mm^3) and mass (kg)."""
 
-    part: Part
-    reasons: list[str]
-    mass_kg: float
+    values: tuple[tuple[str, Value], ...]
+    params: GeometryParams
+    reasons: tuple[str, ...] | None = None  # None: not checked yet
+    volume_mm3: float = math.nan
+    mass_kg: float = math.nan
+
+    @property
+    def name(self) -> str:
+        """E.g. "4 beams x 8 mm" (see `space.label`)."""
+        return candidate_name(self.values)
+
+    @property
+    def stem(self) -> str:
+        """File-name stem of the candidate's exports, e.g. "4beams_8mm"."""
+        return file_stem(self.name)
+
+    @property
+    def checked(self) -> bool:
+        return self.reasons is not None
 
     @property
     def valid(self) -> bool:
+        if self.reasons is None:
+            raise ValueError(f"candidate {self.name} has not been checked yet")
         return not self.reasons
 
-    @property
-    def params(self) -> GeometryParams:
-        return self.part.params
+    def with_geometry(self, reasons: tuple[str, ...], volume_mm3: float, density_kg_per_m3: float) -> "Candidate":
+        """This candidate checked: its validity reasons, volume (mm^3) and mass from the density (kg/m^3)."""
+        return replace(self, reasons=tuple(reasons), volume_mm3=float(volume_mm3),
+                       mass_kg=float(volume_mm3) * 1e-9 * density_kg_per_m3)
 
 
-def check_candidate(study: Study, params: GeometryParams) -> CheckedPart:
-    """Build one candidate and run the validity checks."""
-    part = build_part(params)
-    reasons = check(part, study.validity)
-    mass = part.volume_mm3 * 1e-9 * study.material.density_kg_per_m3
-    return CheckedPart(part, reasons, mass)
+def check_candidate(candidate: Candidate, rules: ValidityRules, density_kg_per_m3: float) -> tuple[Candidate, Part]:
+    """Build the candidate's solid and run the validity checks: (checked candidate, CAD part)."""
+    from seadesign.design.geometry import build_part
+    from seadesign.design.validity import check
 
-
-def find_candidate(study: Study, beam_count: int, beam_thickness_mm: float) -> GeometryParams:
-    """The study's candidate with these parameters (must be in its design space)."""
-    if beam_count not in study.beam_counts or beam_thickness_mm not in study.beam_thicknesses_mm:
-        raise ConfigError(
-            f"--beams {beam_count} --thickness-mm {beam_thickness_mm:g} is not in study '{study.name}' "
-            f"(beam counts {list(study.beam_counts)}, thicknesses {list(study.beam_thicknesses_mm)} mm)"
-        )
-    return study.params(beam_count, beam_thickness_mm)
+    part = build_part(candidate.params)
+    return candidate.with_geometry(tuple(check(part, rules)), part.volume_mm3, density_kg_per_m3), part

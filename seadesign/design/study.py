@@ -1,6 +1,9 @@
 """Study files (`studies/*.toml`): the design space, fixed geometry, material, load cases,
 robot/actuator data, mesh and ranking settings of one design problem.
 
+`[design_space]` names the axes (any numeric geometry key, see `space.py`), `[geometry]` the fixed
+values; each candidate's merged geometry is checked when the study loads.
+
 Every key is validated (present, typed, in range, no unknown keys); derived quantities such
 as the impact torque are computed here from physical inputs, never typed in.
 """
@@ -10,15 +13,21 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from seadesign.errors import ConfigError
+from seadesign.constants import G_M_PER_S2
+from seadesign.design.candidate import Candidate, check_candidate
 from seadesign.design.materials import Material, load_material
-from seadesign.design.params import BoltPattern, GeometryParams, NutSlots, ValidityRules
+from seadesign.design.params import ValidityRules, read_geometry
+from seadesign.design.space import Axis, Value, grid, merged, read_axes
 from seadesign.design.tomlcheck import Table, find_toml, read_toml
+from seadesign.errors import ConfigError
+
+if TYPE_CHECKING:
+    from seadesign.design.geometry import Part
 
 STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
 DEFAULT_STUDY = STUDIES_DIR / "wolfgang_knee.toml"
-G = 9.80665  # m/s^2
 
 
 @dataclass(frozen=True)
@@ -55,7 +64,7 @@ class Robot:
         """Static knee torque standing on two legs: half the weight acting on the lower leg's
         horizontal lever, lower_leg sin(flexion / 2) (hip above ankle, both segments tilted
         by half the flexion)."""
-        return self.mass_kg * G / 2 * self.lower_leg_m * math.sin(math.radians(self.standing_knee_flexion_deg) / 2)
+        return self.mass_kg * G_M_PER_S2 / 2 * self.lower_leg_m * math.sin(math.radians(self.standing_knee_flexion_deg) / 2)
 
 
 @dataclass(frozen=True)
@@ -106,9 +115,8 @@ class Study:
     description: str
     path: Path
     material: Material
-    beam_counts: tuple[int, ...]
-    beam_thicknesses_mm: tuple[float, ...]
-    base: dict  # fixed geometry keyword arguments of GeometryParams
+    axes: tuple[Axis, ...]  # the design space; every other geometry key is fixed
+    fixed: dict  # the raw [geometry] table (nested, mm / deg), without the axes
     validity: ValidityRules
     load_cases: LoadCases
     robot: Robot
@@ -117,80 +125,43 @@ class Study:
     ranking: Ranking
     bearing_radius_mm: float  # where the stall displacement is read (thesis eq. 5.3)
 
-    def candidates(self) -> list[GeometryParams]:
-        """Every (beam count, thickness) combination, thickness-major like the thesis."""
-        return [self.params(n, t) for t in self.beam_thicknesses_mm for n in self.beam_counts]
+    def candidates(self) -> list[Candidate]:
+        """Every combination of the axes' values, the first axis varying fastest."""
+        return [self._candidate(values) for values in grid(self.axes)]
 
-    def params(self, beam_count: int, beam_thickness_mm: float) -> GeometryParams:
-        return GeometryParams(beam_count=beam_count, beam_thickness_mm=beam_thickness_mm, **self.base)
+    def candidate(self, *values: Value, **by_key: Value) -> Candidate:
+        """The candidate with these axis values, in axis order or by key (dotted keys by `**{}`);
+        a value outside the study's design space is refused, naming the axes."""
+        keys = [a.key for a in self.axes]
+        if len(values) > len(keys) or set(by_key) - set(keys):
+            raise ConfigError(f"study '{self.name}' has the design axes {keys}; got values {list(values)} "
+                              f"and keys {sorted(by_key)}")
+        given = dict(zip(keys, values), **by_key)
+        axes_text = "; ".join(f"{a.key} in {list(a.values)}" for a in self.axes)
+        for axis in self.axes:
+            value = given.get(axis.key)
+            if value is None or value not in axis.values:
+                shown = "(missing)" if value is None else f"{value:g}"
+                raise ConfigError(f"{axis.key} = {shown} is not in study '{self.name}' ({axes_text})")
+            given[axis.key] = axis.values[axis.values.index(value)]  # the axis's own type (int or float)
+        return self._candidate(tuple((k, given[k]) for k in keys))
 
+    def check(self, candidate: Candidate) -> tuple[Candidate, "Part"]:
+        """Build and check a candidate with this study's validity rules and material density."""
+        return check_candidate(candidate, self.validity, self.material.density_kg_per_m3)
 
-def _bolts(t: Table, name: str) -> BoltPattern:
-    b = t.table(name)
-    pattern = BoltPattern(
-        count=b.integer("count", ge=1),
-        circle_diameter_mm=b.number("circle_diameter_mm", gt=0),
-        hole_diameter_mm=b.number("hole_diameter_mm", gt=0),
-        start_angle_deg=b.number("start_angle_deg", 0.0),
-        counterbore_diameter_mm=b.number("counterbore_diameter_mm", 0.0, ge=0),
-        counterbore_depth_mm=b.number("counterbore_depth_mm", 0.0, ge=0),
-    )
-    b.done()
-    if pattern.counterbore_diameter_mm and pattern.counterbore_diameter_mm <= pattern.hole_diameter_mm:
-        raise b.error(b.key("counterbore_diameter_mm"), "must be larger than hole_diameter_mm")
-    return pattern
+    def candidate_of_row(self, row) -> Candidate:
+        """The candidate a results-table row (one column per axis) belongs to."""
+        return self.candidate(**{a.key: type(a.values[0])(row[a.key]) for a in self.axes})
 
-
-def _geometry(t: Table) -> dict:
-    g = t.table("geometry")
-    base = dict(
-        hub_radius_mm=g.number("hub_radius_mm", gt=0),
-        arc_radius_mm=g.number("arc_radius_mm", gt=0),
-        ring_width_mm=g.number("ring_width_mm", gt=0),
-        thickness_mm=g.number("thickness_mm", gt=0),
-        first_beam_angle_deg=g.number("first_beam_angle_deg"),
-        clockwise=g.boolean("clockwise"),
-        fillet_radius_mm=g.number("fillet_radius_mm", ge=0),
-        bore_radius_mm=g.number("bore_radius_mm", 0.0, ge=0),
-        hub_bolts=_bolts(g, "hub_bolts"),
-        ring_bolts=_bolts(g, "ring_bolts"),
-    )
-    profile = g.raw("bore_profile_mm", [])
-    if not isinstance(profile, list) or any(
-        not isinstance(p, list) or len(p) != 2 or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in p)
-        for p in profile
-    ):
-        raise g.error(g.key("bore_profile_mm"), "must be a list of [z_mm, radius_mm] pairs")
-    base["bore_profile_mm"] = tuple((float(z), float(r)) for z, r in profile)
-    slots = g.table("nut_slots", optional=True)
-    if slots is not None:
-        base["nut_slots"] = NutSlots(slots.number("width_mm", gt=0), slots.number("z_min_mm", ge=0),
-                                     slots.number("z_max_mm", gt=0))
-        slots.done()
-    g.done()
-
-    # Impossible combinations, named by key.
-    hub_r = base["hub_radius_mm"]
-    ring_in = hub_r + 2 * base["arc_radius_mm"]
-    ring_out = ring_in + base["ring_width_mm"]
-    bore = max([base["bore_radius_mm"]] + [r for _, r in base["bore_profile_mm"]])
-    if bore >= hub_r:
-        raise g.error(g.key("bore_radius_mm"), f"({bore:g} mm) must be smaller than hub_radius_mm ({hub_r:g} mm)")
-    for name, lo, hi in (("hub_bolts", bore, hub_r), ("ring_bolts", ring_in, ring_out)):
-        pat: BoltPattern = base[name]
-        r = pat.circle_diameter_mm / 2
-        if not lo < r - pat.hole_diameter_mm / 2 or not r + pat.hole_diameter_mm / 2 < hi:
-            raise g.error(g.key(f"{name}.circle_diameter_mm"),
-                          f"puts the holes (radius {r:g} mm +- {pat.hole_diameter_mm / 2:g}) outside the "
-                          f"{'hub' if name == 'hub_bolts' else 'ring'} ({lo:g} to {hi:g} mm)")
-    for z, r in base["bore_profile_mm"]:
-        if not 0 <= z <= base["thickness_mm"] or not 0 < r:
-            raise g.error(g.key("bore_profile_mm"), f"point [{z:g}, {r:g}] lies outside 0 <= z <= thickness_mm, r > 0")
-    if "nut_slots" in base:
-        s: NutSlots = base["nut_slots"]
-        if not s.z_min_mm < s.z_max_mm <= base["thickness_mm"]:
-            raise g.error(g.key("nut_slots"), "needs z_min_mm < z_max_mm <= thickness_mm")
-    return base
+    def _candidate(self, values: tuple[tuple[str, Value], ...]) -> Candidate:
+        origins = {f"geometry.{key}": f"design_space.{key}[{axis.values.index(v)}]"
+                   for axis, (key, v) in zip(self.axes, values)}
+        params = read_geometry(Table(merged(self.fixed, values), self.path, "geometry", origins))
+        if self.bearing_radius_mm > params.hub_radius_mm + 1e-9:
+            raise ConfigError(f"{self.path}: bearing_radius_mm must not exceed geometry.hub_radius_mm "
+                              "(it is read on the hub)")
+        return Candidate(values, params)
 
 
 def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
@@ -205,18 +176,10 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
         raise top.error("material", f"cannot be loaded: {exc}") from None
     bearing_radius_mm = top.number("bearing_radius_mm", gt=0)
 
-    space = top.table("design_space")
-    beam_counts = space.number_list("beam_count", integer=True, gt=0)
-    thicknesses = space.number_list("beam_thickness_mm", gt=0)
-    space.done()
-
-    base = _geometry(top)
-    if bearing_radius_mm > base["hub_radius_mm"] + 1e-9:
-        raise top.error("bearing_radius_mm", "must not exceed geometry.hub_radius_mm (it is read on the hub)")
-    for t in thicknesses:
-        if t / 2 >= base["arc_radius_mm"]:
-            raise space.error(space.key("beam_thickness_mm"),
-                              f"value {t:g} mm needs geometry.arc_radius_mm > {t / 2:g} mm (half the beam width)")
+    fixed = top.raw("geometry", None)
+    if not isinstance(fixed, dict):
+        raise top.error("geometry", "is missing or not a table; add [geometry] with the fixed dimensions (mm, deg)")
+    axes = read_axes(top.table("design_space"), fixed)
 
     v = top.table("validity")
     validity = ValidityRules(v.number("min_clearance_mm", gt=0), v.number("min_feature_mm", gt=0),
@@ -269,5 +232,7 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     if ranking.weight_accuracy + ranking.weight_protection <= 0:
         raise ConfigError(f"{path}: ranking.weight_accuracy + ranking.weight_protection must be > 0")
 
-    return Study(name, description, path, material, beam_counts, thicknesses, base, validity, load_cases,
-                 robot, actuator, mesh, ranking, bearing_radius_mm)
+    study = Study(name, description, path, material, axes, fixed, validity, load_cases, robot, actuator, mesh,
+                  ranking, bearing_radius_mm)
+    study.candidates()  # every combination is checked now, so a bad value is named before any work starts
+    return study

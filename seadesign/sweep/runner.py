@@ -20,12 +20,13 @@ from pathlib import Path
 
 import pandas as pd
 
+from seadesign.design.candidate import Candidate
+from seadesign.design.study import Study
 from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.executors import default_jobs, execute
-from seadesign.design.params import GeometryParams
 from seadesign.run.progress import ProgressDisplay
-from seadesign.sweep.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key, load_case_columns
-from seadesign.design.study import Study
+from seadesign.sweep.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key
+from seadesign.sweep.table import candidate_columns, fea_columns, geometry_columns
 
 
 @dataclass(frozen=True)
@@ -34,7 +35,7 @@ class Job:
 
     index: int
     study: Study
-    params: GeometryParams
+    candidate: Candidate
     settings: SolverSettings
     cache: Cache
     row_key: str
@@ -50,21 +51,16 @@ class SweepRun:
     wall_s: float = 0.0
 
 
-def candidate_label(params: GeometryParams) -> str:
-    return f"{params.beam_count} beams x {params.beam_thickness_mm:g} mm"
-
-
-def row_key(study: Study, params: GeometryParams, settings: SolverSettings) -> str:
-    """Hash of every input of one candidate's row (geometry, mesh, material, loads, solver, versions)."""
-    return digest("row", fea_key(study, params, settings), geometry_key(study, params), study.load_cases,
-                  study.bearing_radius_mm, study.material)
+def row_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
+    """Hash of every input of one candidate's row (its axis values, geometry, mesh, material, loads,
+    solver, versions)."""
+    return digest("row", candidate.values, fea_key(study, candidate, settings), geometry_key(study, candidate),
+                  study.load_cases, study.bearing_radius_mm, study.material)
 
 
 def evaluate(job: Job, sink) -> dict:
     """One candidate's row. Never raises for a candidate's own failure: the error is the row."""
-    p = job.params
-    row: dict = {"candidate": candidate_label(p), "beam_count": p.beam_count, "beam_thickness_mm": p.beam_thickness_mm,
-                 "status": "ok", "reason": "", "row_key": job.row_key}
+    row = candidate_columns(job.candidate, job.row_key)
     t0 = time.perf_counter()
 
     def stage(name: str) -> None:
@@ -72,14 +68,13 @@ def evaluate(job: Job, sink) -> dict:
 
     try:
         stage("geometry")
-        geo, checked = check_geometry(job.study, p, job.cache)
-        row["volume_mm3"] = geo.volume_mm3
-        row["mass_g"] = geo.volume_mm3 * 1e-9 * job.study.material.density_kg_per_m3 * 1e3
-        if not geo.valid:
-            row.update(status="invalid", reason="; ".join(geo.reasons))
+        checked, part = check_geometry(job.study, job.candidate, job.cache)
+        row.update(geometry_columns(checked))
+        if not checked.valid:
+            row.update(status="invalid", reason="; ".join(checked.reasons))
         else:
-            unit = fea_response(job.study, p, checked, job.settings, job.cache, stage)
-            row.update(load_case_columns(unit, job.study))
+            unit = fea_response(job.study, checked, part, job.settings, job.cache, stage)
+            row.update(fea_columns(unit, job.study))
     except Exception as exc:  # noqa: BLE001 - a failing candidate is a result, not a crash
         row.update(status="failed", reason=f"{type(exc).__name__}: {exc}".strip(),
                    traceback=traceback.format_exc(limit=4))
@@ -121,7 +116,7 @@ def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverS
     t0 = time.perf_counter()
     rows_dir = Path(out_dir) / "rows"
     candidates = study.candidates()
-    keys = [row_key(study, p, settings) for p in candidates]
+    keys = [row_key(study, c, settings) for c in candidates]
     rows: dict[int, dict] = {}
     for i, key in enumerate(keys):
         stored = read_row(rows_dir, key)
@@ -129,7 +124,7 @@ def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverS
             rows[i] = stored
     reused = sorted(rows)
     todo = [Job(i, study, candidates[i], settings, cache, keys[i]) for i in range(len(candidates)) if i not in rows]
-    display = ProgressDisplay(len(candidates), len(reused), {j.index: candidate_label(j.params) for j in todo}, quiet)
+    display = ProgressDisplay(len(candidates), len(reused), {j.index: j.candidate.name for j in todo}, quiet)
     partial_csv = Path(out_dir) / "results.partial.csv"
     for job, row in execute(evaluate, todo, executor, jobs or default_jobs(), scheduler, display.stage, display.tick):
         write_row(rows_dir, row)
