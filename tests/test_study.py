@@ -81,3 +81,13 @@ def test_every_lazy_command_resolves_and_every_command_is_listed():
     for module in set(COMMAND_MODULES.values()):
         importlib.import_module(f"seadesign.cli.{module}")
     assert set(main.commands) == set(COMMAND_MODULES)  # no command defined but missing from the map
+
+
+def test_old_duplicate_lower_leg_key_loads_with_a_deprecation_message(tmp_path):
+    same = _variant(tmp_path, r"^foot_cell_count = 4", "foot_cell_count = 4\nlower_leg_m = 0.2038")
+    with pytest.warns(FutureWarning, match="load_cases.lower_leg_m is deprecated"):
+        s = load_study(same)
+    assert s.load_cases.impact_torque_Nm == pytest.approx(load_study().load_cases.impact_torque_Nm, rel=1e-15)
+    differ = _variant(tmp_path, r"^foot_cell_count = 4", "foot_cell_count = 4\nlower_leg_m = 0.25")
+    with pytest.raises(ConfigError, match=r"load_cases.lower_leg_m \(0.25 m\) differs from robot.lower_leg_m"):
+        load_study(differ)

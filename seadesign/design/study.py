@@ -11,6 +11,7 @@ as the impact torque are computed here from physical inputs, never typed in.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -37,7 +38,7 @@ class LoadCases:
     stall_torque_Nm: float  # servo stall torque, applied on the hub
     foot_cell_force_N: float  # largest single load-cell reading at impact
     foot_cell_count: int  # cells per foot; the thesis took max cell x count
-    lower_leg_m: float  # knee to foot lever
+    lower_leg_m: float  # knee to foot lever: the robot's lower leg (study key robot.lower_leg_m)
     impact_knee_angle_deg: float  # angle between force and lever at impact
 
     @property
@@ -164,6 +165,19 @@ class Study:
         return Candidate(values, params)
 
 
+def _impact_lever(lc: Table, robot: Robot) -> float:
+    """The impact lever is the robot's lower leg. Older study files also gave it as
+    load_cases.lower_leg_m: still read, with a deprecation message, and refused when it differs."""
+    old = lc.number("lower_leg_m", required=False, gt=0)
+    if old is not None:
+        if old != robot.lower_leg_m:
+            raise lc.error(lc.key("lower_leg_m"), f"({old:g} m) differs from robot.lower_leg_m ({robot.lower_leg_m:g} m); "
+                                                  "the impact lever is the lower leg: remove load_cases.lower_leg_m")
+        warnings.warn(f"{lc.file}: load_cases.lower_leg_m is deprecated (it repeats robot.lower_leg_m, which the "
+                      "impact torque now uses); remove it from the study file", FutureWarning, stacklevel=3)
+    return robot.lower_leg_m
+
+
 def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     """Load and validate a study by path or by name (a file stem in `studies/`)."""
     path = find_toml(path, STUDIES_DIR, "study", "studies")
@@ -186,20 +200,20 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
                              v.number("min_wall_mm", gt=0))
     v.done()
 
+    r = top.table("robot")
+    robot = Robot(r.number("mass_kg", gt=0), r.number("upper_leg_m", gt=0), r.number("lower_leg_m", gt=0),
+                  r.number("standing_knee_flexion_deg", ge=0, lt=180))
+    r.done()
+
     lc = top.table("load_cases")
     load_cases = LoadCases(
         stall_torque_Nm=lc.number("stall_torque_Nm", gt=0),
         foot_cell_force_N=lc.number("foot_cell_force_N", gt=0),
         foot_cell_count=lc.integer("foot_cell_count", ge=1),
-        lower_leg_m=lc.number("lower_leg_m", gt=0),
+        lower_leg_m=_impact_lever(lc, robot),
         impact_knee_angle_deg=lc.number("impact_knee_angle_deg", gt=0, lt=180),
     )
     lc.done()
-
-    r = top.table("robot")
-    robot = Robot(r.number("mass_kg", gt=0), r.number("upper_leg_m", gt=0), r.number("lower_leg_m", gt=0),
-                  r.number("standing_knee_flexion_deg", ge=0, lt=180))
-    r.done()
 
     a = top.table("actuator")
     actuator = Actuator(a.number("gear_ratio", gt=0), a.number("no_load_speed_rpm", gt=0), a.number("backlash_deg", ge=0))
