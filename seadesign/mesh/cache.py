@@ -10,8 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
+from seadesign.run.fingerprint import code_fingerprint
+
 CACHE_ENV = "SEADESIGN_CACHE_DIR"
-FORMAT_VERSION = 1  # bump when the stored arrays or the meshing pipeline change meaning
 
 
 def default_cache_dir() -> Path:
@@ -23,9 +24,9 @@ def default_cache_dir() -> Path:
 
 
 def mesh_key(settings: dict, payload: bytes) -> str:
-    """sha256 of the meshing settings and the geometry bytes (tessellation or BREP)."""
+    """sha256 of the meshing settings, the geometry bytes (tessellation or BREP) and the mesher's code."""
     h = hashlib.sha256()
-    h.update(json.dumps({"format": FORMAT_VERSION, **settings}, sort_keys=True).encode())
+    h.update(json.dumps({"code": code_fingerprint("seadesign.mesh.worker"), **settings}, sort_keys=True).encode())
     h.update(payload)
     return h.hexdigest()
 

@@ -11,6 +11,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from seadesign.run.cache import Cache, digest
+from seadesign.run.fingerprint import code_fingerprint
 from seadesign.design.spring import write_spring
 from seadesign.sweep.rank import Choice
 from seadesign.report.document import write_html, write_markdown
@@ -59,7 +60,7 @@ def export_cad(study: Study, rows: pd.DataFrame, folder: Path, tolerance_mm: flo
     for _, r in rows.iterrows():
         candidate = study.candidate_of_row(r)
         files = [folder / f"{candidate.stem}.stl", folder / f"{candidate.stem}.step"]
-        key = digest(geometry_key(study, candidate), tolerance_mm)
+        key = digest(geometry_key(study, candidate), tolerance_mm, code_fingerprint("seadesign.design.export"))
         if not up_to_date(files, key):
             from seadesign.design.export import export_candidate  # CadQuery: only when a file is (re)written
 
@@ -82,7 +83,8 @@ def write_plots(study: Study, t: pd.DataFrame, choice: Choice, folder: Path) -> 
         "Pareto front": (lambda table, path: fig_pareto(table, choice.index, path), folder / "pareto.png"),
     }
     numbers = t.drop(columns=["elapsed_s", "traceback"], errors="ignore")
-    key = digest("plots", numbers[sorted(numbers.columns)].to_json(), choice.index, axes)
+    key = digest("plots", numbers[sorted(numbers.columns)].to_json(), choice.index, axes,
+                 code_fingerprint("seadesign.report.plots"))
     paths = [path for _, path in figures.values()]
     if not up_to_date(paths, key):
         for draw, path in figures.values():
@@ -103,7 +105,7 @@ def write_renders(study: Study, row: pd.Series, folder: Path, solver: SolverSett
         torque = float(row[f"{case}_torque_Nm"])
         title = f"{row['candidate']}: {case}, {torque:.3g} Nm"
         path = folder / f"chosen_{case}.png"
-        key = digest("render", key_fea, torque, title)
+        key = digest("render", key_fea, torque, title, code_fingerprint("seadesign.report.renders"))
         if not up_to_date([path], key):
             unit = cache.get("fea", key_fea)
             if unit is None or render_case(unit, case, torque, title, path) is None:

@@ -1,7 +1,8 @@
 """Content-addressed cache of sweep stages (geometry, mesh, unit FEA response).
 
 A key is the SHA-256 of the canonical JSON of everything a stage's output depends on: its
-inputs, the key of the stage before it, and the versions of the packages that compute it.
+inputs, the key of the stage before it, the fingerprint of the project code that computes it
+(`run/fingerprint.py`) and the versions of the third-party packages that do.
 Entries are pickles written atomically, so an interrupted write never leaves a bad entry.
 """
 
@@ -69,7 +70,7 @@ class Cache:
         try:
             with self.path(stage, key).open("rb") as fh:
                 return pickle.load(fh)
-        except (FileNotFoundError, EOFError, pickle.UnpicklingError):
+        except Exception:  # noqa: BLE001 - missing, truncated, or pickled by other code: recompute
             return None
 
     def put(self, stage: str, key: str, value: Any) -> None:

@@ -25,6 +25,7 @@ import numpy as np
 from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
 from seadesign.run.cache import Cache, digest, package_versions
+from seadesign.run.fingerprint import code_fingerprint
 
 if TYPE_CHECKING:
     from seadesign.design.geometry import Part
@@ -62,18 +63,24 @@ class UnitResponse:
 
 
 def geometry_key(study: Study, candidate: Candidate) -> str:
-    return digest("geometry", candidate.params, study.validity, package_versions(("seadesign", "cadquery")))
+    """Inputs of the geometry verdict: the parameters, the rules, the CAD code and kernel."""
+    return digest("geometry", candidate.params, study.validity, code_fingerprint("seadesign.design.candidate"),
+                  package_versions(("cadquery",)))
 
 
 def mesh_key(study: Study, candidate: Candidate) -> str:
     """Inputs of the mesh (the mesh package keys its own cache by the surface it receives)."""
-    return digest("mesh", geometry_key(study, candidate), study.mesh, package_versions(("pytetwild", "gmsh")))
+    return digest("mesh", geometry_key(study, candidate), study.mesh,
+                  code_fingerprint("seadesign.mesh", "seadesign.mesh.worker"), package_versions(("pytetwild", "gmsh")))
 
 
 def fea_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
+    """Inputs of the unit response: the mesh, the material, the solver settings, and the code of
+    this module with everything it imports (the solver, the mesher, the study's mesh sizing)."""
     m = study.material
     return digest("fea", mesh_key(study, candidate), m.youngs_modulus_Pa, m.poisson_ratio,
-                  settings.element_order, settings.linear_solver, package_versions())
+                  settings.element_order, settings.linear_solver,
+                  code_fingerprint("seadesign.sweep.stages", "seadesign.mesh.worker"), package_versions())
 
 
 def check_geometry(study: Study, candidate: Candidate, cache: Cache) -> tuple[Candidate, Part | None]:
