@@ -148,7 +148,8 @@ def test_failing_candidate_is_recorded_and_the_sweep_goes_on(tmp_path, monkeypat
 
     monkeypatch.setattr(stages, "tetrahedralize", broken)
     study = load_study(write_tiny_study(tmp_path, beam_count="[3, 10]"))
-    run = run_sweep(study, tmp_path / "out", cache=Cache(tmp_path / "c", enabled=False), jobs=1, quiet=True)
+    run = run_sweep(study, tmp_path / "out", cache=Cache(tmp_path / "c", enabled=False), executor="serial",
+                    quiet=True)
     rows = run.rows.set_index("beam_count")
     assert rows.loc[3, "status"] == "failed" and "mesher gave up" in rows.loc[3, "reason"]
     assert rows.loc[10, "status"] == "invalid"

@@ -10,6 +10,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from seadesign.run.atomic import atomic_write
 from seadesign.run.cache import Cache, digest
 from seadesign.run.fingerprint import code_fingerprint
 from seadesign.design.spring import write_spring
@@ -30,12 +31,9 @@ def write_tables(t: pd.DataFrame, settings: dict, folder: Path) -> list[Path]:
     table = table.replace_schema_metadata({**(table.schema.metadata or {}),
                                            b"seadesign.settings": json.dumps(settings, default=str).encode()})
     paths = [folder / "results.parquet", folder / "results.csv", folder / "settings.json"]
-    tmp = paths[0].with_suffix(".tmp.parquet")
-    pq.write_table(table, tmp)
-    tmp.replace(paths[0])
-    t.drop(columns=["traceback"], errors="ignore").to_csv(paths[1].with_suffix(".tmp.csv"), index=False)
-    paths[1].with_suffix(".tmp.csv").replace(paths[1])
-    paths[2].write_text(json.dumps(settings, indent=2, sort_keys=True, default=str) + "\n")
+    atomic_write(paths[0], lambda tmp: pq.write_table(table, tmp))
+    atomic_write(paths[1], lambda tmp: t.drop(columns=["traceback"], errors="ignore").to_csv(tmp, index=False))
+    atomic_write(paths[2], lambda tmp: tmp.write_text(json.dumps(settings, indent=2, sort_keys=True, default=str) + "\n"))
     return paths
 
 

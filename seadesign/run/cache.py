@@ -3,7 +3,7 @@
 A key is the SHA-256 of the canonical JSON of everything a stage's output depends on: its
 inputs, the key of the stage before it, the fingerprint of the project code that computes it
 (`run/fingerprint.py`) and the versions of the third-party packages that do.
-Entries are pickles written atomically, so an interrupted write never leaves a bad entry.
+Entries are pickles written atomically (`atomic.py`), so an interrupted write never leaves a bad entry.
 """
 
 from __future__ import annotations
@@ -16,6 +16,8 @@ import pickle
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+from seadesign.run.atomic import atomic_write
 
 DEFAULT_CACHE_DIR = Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
 TRACKED_PACKAGES = ("seadesign", "numpy", "scipy", "cadquery", "gmsh", "pytetwild", "mkl")
@@ -76,9 +78,4 @@ class Cache:
     def put(self, stage: str, key: str, value: Any) -> None:
         if not self.enabled:
             return
-        path = self.path(stage, key)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        with tmp.open("wb") as fh:
-            pickle.dump(value, fh, protocol=pickle.HIGHEST_PROTOCOL)
-        tmp.replace(path)
+        atomic_write(self.path(stage, key), lambda tmp: tmp.write_bytes(pickle.dumps(value, pickle.HIGHEST_PROTOCOL)))

@@ -3,8 +3,9 @@
 Rows are written as they arrive, one JSON file per candidate under `<out>/rows/`, named by a
 hash of every input of that candidate (atomic write: temp file + rename). A rerun reuses rows
 whose inputs are unchanged (failed ones are retried), so an interrupted sweep resumes where it
-stopped; stages of the
-others come from the content-addressed cache when their own inputs are unchanged.
+stopped; stages of the others come from the content-addressed cache when their own inputs are
+unchanged. Interrupted (Ctrl-C, SIGTERM), the sweep stops its workers at once, removes their
+half-written files and raises `SweepStopped` with the count of saved rows.
 Invalid candidates keep their reasons; a candidate whose mesher or solver fails keeps the
 error and the sweep goes on.
 """
@@ -22,8 +23,10 @@ import pandas as pd
 
 from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
+from seadesign.run.atomic import atomic_write
 from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.executors import default_jobs, execute
+from seadesign.run.interrupt import Interrupted, remove_partial_files
 from seadesign.run.progress import ProgressDisplay
 from seadesign.sweep.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key
 from seadesign.sweep.table import candidate_columns, fea_columns, geometry_columns
@@ -39,6 +42,14 @@ class Job:
     settings: SolverSettings
     cache: Cache
     row_key: str
+
+
+class SweepStopped(Interrupted):
+    """A sweep stopped by a signal: how many candidates have saved rows, and where."""
+
+    def __init__(self, signal_name: str, saved: int, total: int, rows_dir: Path) -> None:
+        super().__init__(signal_name)
+        self.saved, self.total, self.rows_dir = saved, total, rows_dir
 
 
 @dataclass
@@ -83,13 +94,8 @@ def evaluate(job: Job, sink) -> dict:
 
 
 def write_row(folder: Path, row: dict) -> Path:
-    """Atomically write one row as JSON."""
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{row['row_key']}.json"
-    tmp = path.with_suffix(f".{os.getpid()}.tmp")
-    tmp.write_text(json.dumps(row))  # key order kept: the same columns cold and warm
-    tmp.replace(path)
-    return path
+    """Atomically write one row as JSON (key order kept: the same columns cold and warm)."""
+    return atomic_write(folder / f"{row['row_key']}.json", lambda tmp: tmp.write_text(json.dumps(row)))
 
 
 def read_row(folder: Path, key: str) -> dict | None:
@@ -100,12 +106,8 @@ def read_row(folder: Path, key: str) -> dict | None:
 
 
 def write_table_atomic(df: pd.DataFrame, path: Path) -> None:
-    tmp = path.with_suffix(".tmp" + path.suffix)
-    if path.suffix == ".parquet":
-        df.to_parquet(tmp, index=False)
-    else:
-        df.to_csv(tmp, index=False)
-    tmp.replace(path)
+    """A table as CSV, atomically."""
+    atomic_write(path, lambda tmp: df.to_csv(tmp, index=False))
 
 
 def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverSettings(), cache: Cache = Cache(),
@@ -126,13 +128,23 @@ def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverS
     todo = [Job(i, study, candidates[i], settings, cache, keys[i]) for i in range(len(candidates)) if i not in rows]
     display = ProgressDisplay(len(candidates), len(reused), {j.index: j.candidate.name for j in todo}, quiet)
     partial_csv = Path(out_dir) / "results.partial.csv"
-    for job, row in execute(evaluate, todo, executor, jobs or default_jobs(), scheduler, display.stage, display.tick):
-        write_row(rows_dir, row)
-        rows[job.index] = row
-        display.finished(job.index, row["status"])
-        write_table_atomic(pd.DataFrame([rows[i] for i in sorted(rows)]), partial_csv)
-        if on_row is not None:
-            on_row(row)
+    killed: list[int] = []
+    stream = execute(evaluate, todo, executor, jobs or default_jobs(), scheduler, display.stage, display.tick, killed)
+    try:
+        for job, row in stream:
+            write_row(rows_dir, row)
+            rows[job.index] = row
+            display.finished(job.index, row["status"])
+            write_table_atomic(pd.DataFrame([rows[i] for i in sorted(rows)]), partial_csv)
+            if on_row is not None:
+                on_row(row)
+    except KeyboardInterrupt as exc:
+        stream.close()  # cancels what is pending and kills the workers
+        remove_partial_files([rows_dir, Path(cache.root)], killed + [os.getpid()])
+        display.close()
+        raise SweepStopped(getattr(exc, "signal", "SIGINT"), len(rows), len(candidates), rows_dir) from None
+    finally:
+        stream.close()
     display.close()
     partial_csv.unlink(missing_ok=True)
     table = pd.DataFrame([rows[i] for i in range(len(candidates))])
