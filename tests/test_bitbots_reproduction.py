@@ -25,8 +25,9 @@ def test_bitbots_part_is_reproduced():
     c, part = study.check(study.candidates()[0])
     assert c.valid, c.reasons
     ours = tessellate(part.solid, tolerance_mm=0.01)
-    assert c.volume_mm3 == pytest.approx(stl.volume, rel=0.02)
-    assert ours.volume == pytest.approx(stl.volume, rel=0.02)
+    # measured: volume +0.031 % (CAD) and -0.017 % (tessellated), mean distance 0.0055 mm, 99th percentile 0.050 mm
+    assert c.volume_mm3 == pytest.approx(stl.volume, rel=1e-3)
+    assert ours.volume == pytest.approx(stl.volume, rel=1e-3)
     d = np.concatenate([_surface_distances(ours, stl, 20000, 1), _surface_distances(stl, ours, 20000, 2)])
-    assert d.mean() < 0.3  # mm, symmetric mean surface distance
-    assert np.percentile(d, 99) < 0.3
+    assert d.mean() < 0.02  # mm, symmetric mean surface distance
+    assert np.percentile(d, 99) < 0.15

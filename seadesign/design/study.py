@@ -178,33 +178,23 @@ def _impact_lever(lc: Table, robot: Robot) -> float:
     return robot.lower_leg_m
 
 
-def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
-    """Load and validate a study by path or by name (a file stem in `studies/`)."""
-    path = find_toml(path, STUDIES_DIR, "study", "studies")
-    top = Table(read_toml(path), path)
-    name = top.string("name")
-    description = top.string("description")
-    try:
-        material = load_material(top.string("material"))
-    except ConfigError as exc:
-        raise top.error("material", f"cannot be loaded: {exc}") from None
-    bearing_radius_mm = top.number("bearing_radius_mm", gt=0)
-
-    fixed = top.raw("geometry", None)
-    if not isinstance(fixed, dict):
-        raise top.error("geometry", "is missing or not a table; add [geometry] with the fixed dimensions (mm, deg)")
-    axes = read_axes(top.table("design_space"), fixed)
-
+def _validity(top: Table) -> ValidityRules:
     v = top.table("validity")
-    validity = ValidityRules(v.number("min_clearance_mm", gt=0), v.number("min_feature_mm", gt=0),
-                             v.number("min_wall_mm", gt=0))
+    rules = ValidityRules(v.number("min_clearance_mm", gt=0), v.number("min_feature_mm", gt=0),
+                          v.number("min_wall_mm", gt=0))
     v.done()
+    return rules
 
+
+def _robot(top: Table) -> Robot:
     r = top.table("robot")
     robot = Robot(r.number("mass_kg", gt=0), r.number("upper_leg_m", gt=0), r.number("lower_leg_m", gt=0),
                   r.number("standing_knee_flexion_deg", ge=0, lt=180))
     r.done()
+    return robot
 
+
+def _load_cases(top: Table, robot: Robot) -> LoadCases:
     lc = top.table("load_cases")
     load_cases = LoadCases(
         stall_torque_Nm=lc.number("stall_torque_Nm", gt=0),
@@ -214,11 +204,17 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
         impact_knee_angle_deg=lc.number("impact_knee_angle_deg", gt=0, lt=180),
     )
     lc.done()
+    return load_cases
 
+
+def _actuator(top: Table) -> Actuator:
     a = top.table("actuator")
     actuator = Actuator(a.number("gear_ratio", gt=0), a.number("no_load_speed_rpm", gt=0), a.number("backlash_deg", ge=0))
     a.done()
+    return actuator
 
+
+def _mesh(top: Table) -> MeshSettings:
     m = top.table("mesh")
     mesh = MeshSettings(m.number("elements_across_beam", gt=0), m.string("backend", "gmsh"),
                         m.number("elements_per_circle", 0.0, ge=0), m.number("layers", 0.0, ge=0))
@@ -228,7 +224,10 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     if mesh.backend != "gmsh" and mesh.elements_per_circle > 0:
         raise m.error(m.key("elements_per_circle"), "curvature-based sizing needs backend = 'gmsh'; set it to 0 "
                                                     "for pytetwild")
+    return mesh
 
+
+def _ranking(top: Table) -> Ranking:
     rk = top.table("ranking")
     ranking = Ranking(
         safety_factor=rk.number("safety_factor", ge=1),
@@ -242,11 +241,29 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
         weight_protection=rk.number("weight_protection", ge=0),
     )
     rk.done()
-    top.done()
     if ranking.weight_accuracy + ranking.weight_protection <= 0:
-        raise ConfigError(f"{path}: ranking.weight_accuracy + ranking.weight_protection must be > 0")
+        raise ConfigError(f"{top.file}: ranking.weight_accuracy + ranking.weight_protection must be > 0")
+    return ranking
 
-    study = Study(name, description, path, material, axes, fixed, validity, load_cases, robot, actuator, mesh,
-                  ranking, bearing_radius_mm)
+
+def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
+    """Load and validate a study by path or by name (a file stem in `studies/`)."""
+    path = find_toml(path, STUDIES_DIR, "study", "studies")
+    top = Table(read_toml(path), path)
+    name = top.string("name")
+    description = top.string("description")
+    try:
+        material = load_material(top.string("material"))
+    except ConfigError as exc:
+        raise top.error("material", f"cannot be loaded: {exc}") from None
+    bearing_radius_mm = top.number("bearing_radius_mm", gt=0)
+    fixed = top.raw("geometry", None)
+    if not isinstance(fixed, dict):
+        raise top.error("geometry", "is missing or not a table; add [geometry] with the fixed dimensions (mm, deg)")
+    axes = read_axes(top.table("design_space"), fixed)
+    robot = _robot(top)
+    study = Study(name, description, path, material, axes, fixed, _validity(top), _load_cases(top, robot), robot,
+                  _actuator(top), _mesh(top), _ranking(top), bearing_radius_mm)
+    top.done()
     study.candidates()  # every combination is checked now, so a bad value is named before any work starts
     return study

@@ -61,6 +61,48 @@ def _stress_peaks(voigt_Pa: np.ndarray, nodes_mm: np.ndarray) -> dict[str, Stres
     return out
 
 
+def _results(unit: UnitTorsion, stress_per_Nm: np.ndarray, torque: dict[str, float], yield_strength_Pa: float,
+             bearing_radius_mm: float, stats: SolveStats) -> LinearResults:
+    """The load-case numbers of one unit solve at the given hub torques (stall +T, impact -T)."""
+    theta = float(unit.hub_motion[5])
+    nodes_mm = unit.emesh.nodes_m / MM
+    f = unit.nodal_force_N
+    ring = unit.ring_nodes
+    ring_torque = float(np.sum(unit.emesh.nodes_m[ring, 0] * f[ring, 1] - unit.emesh.nodes_m[ring, 1] * f[ring, 0]))
+    equilibrium = abs(ring_torque + 1.0)  # reaction torque must cancel the applied 1 Nm
+
+    # bearing circle at the reference plane, moving with the rigid hub
+    phi = np.linspace(0.0, 2 * np.pi, 720, endpoint=False)
+    circle = np.column_stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)]) * bearing_radius_mm * MM
+    bearing_per_Nm = float(np.linalg.norm(unit.hub_motion[:3] + np.cross(unit.hub_motion[3:], circle), axis=1).max())
+
+    bolt = [np.linalg.norm(f[nodes].sum(axis=0)) for nodes in unit.hub_groups.values()]
+    hub_nodes = np.unique(np.concatenate(list(unit.hub_groups.values())))
+    peak_nodal = float(np.linalg.norm(f[hub_nodes], axis=1).max())
+
+    t_stall, t_impact = torque["stall"], -torque["impact"]
+    peaks = {case: _stress_peaks(stress_per_Nm * t, nodes_mm) for case, t in torque.items()}
+    stall = StallResult(
+        torque_Nm=t_stall, rotation_rad=t_stall * theta, bearing_displacement_mm=t_stall * bearing_per_Nm / MM,
+        **peaks["stall"], safety_factor=yield_strength_Pa / (peaks["stall"]["von_mises_max"].MPa * 1e6))
+    impact = ImpactResult(
+        torque_Nm=t_impact, reaction_per_bolt_N=t_impact * float(max(bolt)),
+        reaction_per_bolt_min_N=t_impact * float(min(bolt)), bolt_count=float(len(bolt)),
+        peak_nodal_reaction_N=t_impact * peak_nodal, **peaks["impact"],
+        safety_factor=yield_strength_Pa / (peaks["impact"]["von_mises_max"].MPa * 1e6))
+    return LinearResults(k_Nm_per_rad=1.0 / theta, equilibrium_rel_error=equilibrium, stall=stall, impact=impact,
+                         stats=stats)
+
+
+def _stats(unit: UnitTorsion, mesh: TetMesh, order: int, t_stress: float) -> SolveStats:
+    t = unit.timings_s
+    return SolveStats(
+        element_order=float(order), dofs=float(unit.n_dofs), mesh_nodes=float(len(mesh.points_mm)),
+        mesh_tets=float(len(mesh.tets)), mesh_min_dihedral_deg=mesh.quality.min_dihedral_deg,
+        mesh_max_aspect_ratio=mesh.quality.max_aspect_ratio, time_setup_s=t["setup"], time_assembly_s=t["assembly"],
+        time_factorization_s=t["factorization"], time_solve_s=t["solve"], time_stress_s=t_stress)
+
+
 def analyse(
     mesh: TetMesh,
     youngs_modulus_Pa: float,
@@ -97,40 +139,8 @@ def analyse(
     theta = float(unit.hub_motion[5])
     if not theta > 0:
         raise SolverError(f"hub rotation per Nm is {theta:g} rad; the mesh or its couplings are broken")
-    nodes_mm = unit.emesh.nodes_m / MM
-    f = unit.nodal_force_N
-    ring = unit.ring_nodes
-    ring_torque = float(np.sum(unit.emesh.nodes_m[ring, 0] * f[ring, 1] - unit.emesh.nodes_m[ring, 1] * f[ring, 0]))
-    equilibrium = abs(ring_torque + 1.0)  # reaction torque must cancel the applied 1 Nm
-
-    # bearing circle at the reference plane, moving with the rigid hub
-    phi = np.linspace(0.0, 2 * np.pi, 720, endpoint=False)
-    circle = np.column_stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)]) * bearing_radius_mm * MM
-    bearing = unit.hub_motion[:3] + np.cross(unit.hub_motion[3:], circle)
-    bearing_per_Nm = float(np.linalg.norm(bearing, axis=1).max())
-
-    bolt = [np.linalg.norm(f[nodes].sum(axis=0)) for nodes in unit.hub_groups.values()]
-    hub_nodes = np.unique(np.concatenate(list(unit.hub_groups.values())))
-    peak_nodal = float(np.linalg.norm(f[hub_nodes], axis=1).max())
-
     torque = {"stall": float(stall_torque_Nm), "impact": -float(impact_torque_Nm)}
-    peaks = {case: _stress_peaks(stress * t, nodes_mm) for case, t in torque.items()}
-    stall = StallResult(
-        torque_Nm=float(stall_torque_Nm), rotation_rad=stall_torque_Nm * theta,
-        bearing_displacement_mm=stall_torque_Nm * bearing_per_Nm / MM, **peaks["stall"],
-        safety_factor=yield_strength_Pa / (peaks["stall"]["von_mises_max"].MPa * 1e6))
-    impact = ImpactResult(
-        torque_Nm=float(impact_torque_Nm), reaction_per_bolt_N=impact_torque_Nm * float(max(bolt)),
-        reaction_per_bolt_min_N=impact_torque_Nm * float(min(bolt)), bolt_count=float(len(bolt)),
-        peak_nodal_reaction_N=impact_torque_Nm * peak_nodal, **peaks["impact"],
-        safety_factor=yield_strength_Pa / (peaks["impact"]["von_mises_max"].MPa * 1e6))
-    t = unit.timings_s
-    stats = SolveStats(
-        element_order=float(order), dofs=float(unit.n_dofs), mesh_nodes=float(len(mesh.points_mm)),
-        mesh_tets=float(len(mesh.tets)), mesh_min_dihedral_deg=mesh.quality.min_dihedral_deg,
-        mesh_max_aspect_ratio=mesh.quality.max_aspect_ratio, time_setup_s=t["setup"], time_assembly_s=t["assembly"],
-        time_factorization_s=t["factorization"], time_solve_s=t["solve"], time_stress_s=t_stress)
-    results = LinearResults(k_Nm_per_rad=1.0 / theta, equilibrium_rel_error=equilibrium, stall=stall, impact=impact,
-                            stats=stats)
+    results = _results(unit, stress, torque, yield_strength_Pa, bearing_radius_mm,
+                       _stats(unit, mesh, order, t_stress))
     return Analysis(unit=unit, stress_per_Nm_Pa=stress, hub_torque_Nm=torque, results=results)
 
