@@ -128,14 +128,14 @@ def test_degenerate_tight_arc_is_invalid(study):
     base = study.candidate(4, 8.0).params
     p = dataclasses.replace(base, arc_radius_mm=4.05,
                             ring_bolts=dataclasses.replace(base.ring_bolts, circle_diameter_mm=2 * (14 + 8.1 + 4)))
-    reasons = study.check(Candidate((), p))[0].reasons
+    reasons = study.check(Candidate((), p, study.material))[0].reasons
     assert any("degenerate feature" in r for r in reasons), reasons
 
 
 def test_bolt_hole_cutting_a_gap_is_invalid(study):
     # ring holes pushed onto the ring's inner edge open into the gaps between beams
     p = _plain(study, ring_bolts=BoltPattern(8, 2 * 24.5, 3.2, 22.5))
-    reasons = study.check(Candidate((), p))[0].reasons
+    reasons = study.check(Candidate((), p, study.material))[0].reasons
     assert any("ring bolt hole" in r and "gap" in r for r in reasons), reasons
 
 

@@ -3,8 +3,8 @@ ranks, reports and hands off with no code change; dotted keys name nested values
 
 from __future__ import annotations
 
-import json
 import re
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -26,7 +26,7 @@ def _study_text(**lines: str) -> str:
     return text
 
 
-def thickness_study(folder) -> "Path":
+def thickness_study(folder: Path) -> Path:
     text = _study_text(thickness_mm="beam_count = 5\nbeam_thickness_mm = 6.0", name='name = "axial"',
                        beam_count="thickness_mm = [8.0, 12.0]", beam_thickness_mm="", elements_across_beam=
                        "elements_across_beam = 0.6", elements_per_circle="elements_per_circle = 0", layers="layers = 2")
@@ -94,3 +94,28 @@ def test_solve_and_export_pick_a_candidate_by_any_axis(tmp_path):
     assert result.exit_code == 2 and "thickness_mm = 10 is not in study 'axial'" in result.output
     result = CliRunner().invoke(main, ["export", str(path), "--out", str(tmp_path / "o")])
     assert result.exit_code == 2 and "--param KEY=VALUE for each design axis of 'axial': thickness_mm" in result.output
+
+
+def test_ranges_continuous_bounds_and_a_material_axis(tmp_path):
+    text = _study_text(arc_radius_mm="", material="", beam_thickness_mm="beam_thickness_mm = [6.0]",
+                       beam_count='beam_count = {min = 3, max = 7, step = 2}\narc_radius_mm = {min = 4.5, max = 6.0}\n'
+                                  'material = ["ninjaflex", "cheetah"]')
+    path = tmp_path / "mixed.toml"
+    path.write_text(text)
+    study = load_study(path)
+    axes = {a.key: a for a in study.axes}
+    assert axes["beam_count"].values == (3, 5, 7)
+    assert axes["arc_radius_mm"].continuous and axes["arc_radius_mm"].bounds == (4.5, 6.0)
+    assert axes["material"].values == ("ninjaflex", "cheetah")
+    with pytest.raises(ValueError, match="continuous axes"):
+        study.candidates()
+    c = study.candidate(arc_radius_mm=5.123456789, beam_count=5, beam_thickness_mm=6.0, material="cheetah")
+    assert c.params.arc_radius_mm == 5.123456789  # exact in the geometry (and so in every cache key)
+    assert "arc radius 5.12 mm" in c.name and "cheetah" in c.name  # rounded to 0.01 mm in the name
+    assert c.material.name.startswith("NinjaTek Cheetah")
+    checked, _ = study.check(c)
+    assert checked.mass_kg == pytest.approx(checked.volume_mm3 * 1e-9 * 1220.0, rel=1e-12)  # Cheetah's density
+    with pytest.raises(ConfigError, match=r"arc_radius_mm = 6.5 is not in study .*arc_radius_mm in \[4.5, 6\]"):
+        study.candidate(arc_radius_mm=6.5, beam_count=5, beam_thickness_mm=6.0, material="cheetah")
+    with pytest.raises(ConfigError, match="material as a design axis"):
+        study.material

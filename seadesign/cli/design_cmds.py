@@ -22,11 +22,11 @@ TOL_OPT = click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0
 def geometry(study: str) -> None:
     """List every candidate of STUDY (name in studies/ or a path): valid or not, why, volume and mass.
 
-    Volume in mm^3, mass in g (from the study material's density).
+    Volume in mm^3, mass in g (from the candidate material's density).
     """
     s = load_study(study)
     candidates = s.candidates()
-    click.echo(f"study {s.name}: {len(candidates)} candidates, material {s.material.name}")
+    click.echo(f"study {s.name}: {len(candidates)} candidates, material {', '.join(m.name for m in s.materials.values())}")
     width = max(len("candidate"), *(len(c.name) for c in candidates))
     click.echo(f"{'candidate':<{width}} {'valid':>5} {'volume_mm3':>11} {'mass_g':>7}  reason")
     for candidate in candidates:

@@ -86,7 +86,7 @@ def solve(study, beams, thickness_mm, param, stl, axis, beam_width_mm, material,
         if not checked.valid:
             raise ConfigError(f"candidate {checked.name} is invalid: {'; '.join(checked.reasons)}")
         geometry, interfaces = part.solid, part.interfaces
-        mat = load_material(material) if material else st.material
+        mat = load_material(material) if material else checked.material
         name, width = checked.stem, checked.params.beam_thickness_mm
         bearing = bearing_radius_mm or st.bearing_radius_mm
         across = elements_across_beam or st.mesh.elements_across_beam

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import logging
 import shlex
@@ -35,9 +34,13 @@ def apply_calibration(study: Study, path: Path) -> tuple[Study, str]:
     value = data[key]
     if not isinstance(value, (int, float)) or isinstance(value, bool) or not value > 0:
         raise ConfigError(f"--calibration {path}: '{key}' must be a positive number, got {value!r}")
-    scale = value if key == "stiffness_scale" else value / study.material.youngs_modulus_Pa
-    note = f"calibrated from {Path(path).name} ({key} = {value:.4g}): E = {study.material.youngs_modulus_Pa * scale:.4g} Pa"
-    return dataclasses.replace(study, material=study.material.scaled(scale, note)), note
+    if len(study.materials) != 1:
+        raise ConfigError(f"--calibration {path}: study '{study.name}' has the material as a design axis; a "
+                          "calibration is fitted to one material: fix the material in the study to calibrate it")
+    (name, material), = study.materials.items()
+    scale = value if key == "stiffness_scale" else value / material.youngs_modulus_Pa
+    note = f"calibrated from {Path(path).name} ({key} = {value:.4g}): E = {material.youngs_modulus_Pa * scale:.4g} Pa"
+    return study.with_materials({name: material.scaled(scale, note)}), note
 
 
 @main.command()

@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
+from seadesign.design.materials import Material
 from seadesign.design.params import GeometryParams, ValidityRules
 from seadesign.design.space import Value, candidate_name, file_stem
 
@@ -21,11 +22,12 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Candidate:
-    """Design-axis values (key, value) in the study's axis order, the geometry they give, and,
-    once checked, the validity reasons (empty: valid), volume (mm^3) and mass (kg)."""
+    """Design-axis values (key, value) in the study's axis order, the geometry and material they
+    give, and, once checked, the validity reasons (empty: valid), volume (mm^3) and mass (kg)."""
 
     values: tuple[tuple[str, Value], ...]
     params: GeometryParams
+    material: Material
     reasons: tuple[str, ...] | None = None  # None: not checked yet
     volume_mm3: float = math.nan
     mass_kg: float = math.nan
@@ -50,16 +52,16 @@ class Candidate:
             raise ValueError(f"candidate {self.name} has not been checked yet")
         return not self.reasons
 
-    def with_geometry(self, reasons: tuple[str, ...], volume_mm3: float, density_kg_per_m3: float) -> "Candidate":
-        """This candidate checked: its validity reasons, volume (mm^3) and mass from the density (kg/m^3)."""
+    def with_geometry(self, reasons: tuple[str, ...], volume_mm3: float) -> "Candidate":
+        """This candidate checked: its validity reasons, volume (mm^3) and mass (kg, from its material)."""
         return replace(self, reasons=tuple(reasons), volume_mm3=float(volume_mm3),
-                       mass_kg=float(volume_mm3) * 1e-9 * density_kg_per_m3)
+                       mass_kg=float(volume_mm3) * 1e-9 * self.material.density_kg_per_m3)
 
 
-def check_candidate(candidate: Candidate, rules: ValidityRules, density_kg_per_m3: float) -> tuple[Candidate, Part]:
+def check_candidate(candidate: Candidate, rules: ValidityRules) -> tuple[Candidate, Part]:
     """Build the candidate's solid and run the validity checks: (checked candidate, CAD part)."""
     from seadesign.design.geometry import build_part
     from seadesign.design.validity import check
 
     part = build_part(candidate.params)
-    return candidate.with_geometry(tuple(check(part, rules)), part.volume_mm3, density_kg_per_m3), part
+    return candidate.with_geometry(tuple(check(part, rules)), part.volume_mm3), part

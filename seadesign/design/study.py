@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import warnings
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,7 +21,7 @@ from seadesign.constants import G_M_PER_S2
 from seadesign.design.candidate import Candidate, check_candidate
 from seadesign.design.materials import Material, load_material
 from seadesign.design.params import ValidityRules, read_geometry
-from seadesign.design.space import Axis, Value, grid, merged, read_axes
+from seadesign.design.space import MATERIAL_KEY, Axis, Value, grid, merged, read_axes
 from seadesign.design.tomlcheck import Table, find_toml, read_toml
 from seadesign.errors import ConfigError
 
@@ -115,7 +116,7 @@ class Study:
     name: str
     description: str
     path: Path
-    material: Material
+    materials: dict[str, Material]  # by file stem: the fixed material, or every value of a material axis
     axes: tuple[Axis, ...]  # the design space; every other geometry key is fixed
     fixed: dict  # the raw [geometry] table (nested, mm / deg), without the axes
     validity: ValidityRules
@@ -126,8 +127,19 @@ class Study:
     ranking: Ranking
     bearing_radius_mm: float  # where the stall displacement is read (thesis eq. 5.3)
 
+    @property
+    def material(self) -> Material:
+        """The study's one material (a study whose material is a design axis has none)."""
+        if len(self.materials) != 1 or any(a.key == MATERIAL_KEY for a in self.axes):
+            raise ConfigError(f"study '{self.name}' has the material as a design axis; ask its candidates")
+        return next(iter(self.materials.values()))
+
+    def with_materials(self, materials: dict[str, Material]) -> "Study":
+        """The same study with other material data under the same names (e.g. a calibrated modulus)."""
+        return dataclasses.replace(self, materials={**self.materials, **materials})
+
     def candidates(self) -> list[Candidate]:
-        """Every combination of the axes' values, the first axis varying fastest."""
+        """Every combination of the discrete axes' values, the first axis varying fastest."""
         return [self._candidate(values) for values in grid(self.axes)]
 
     def candidate(self, *values: Value, **by_key: Value) -> Candidate:
@@ -138,31 +150,33 @@ class Study:
             raise ConfigError(f"study '{self.name}' has the design axes {keys}; got values {list(values)} "
                               f"and keys {sorted(by_key)}")
         given = dict(zip(keys, values), **by_key)
-        axes_text = "; ".join(f"{a.key} in {list(a.values)}" for a in self.axes)
+        axes_text = "; ".join(a.describe() for a in self.axes)
         for axis in self.axes:
             value = given.get(axis.key)
-            if value is None or value not in axis.values:
-                shown = "(missing)" if value is None else f"{value:g}"
+            if value is None or not axis.contains(value):
+                shown = "(missing)" if value is None else value if isinstance(value, str) else f"{value:g}"
                 raise ConfigError(f"{axis.key} = {shown} is not in study '{self.name}' ({axes_text})")
-            given[axis.key] = axis.values[axis.values.index(value)]  # the axis's own type (int or float)
+            given[axis.key] = axis.exact(value)
         return self._candidate(tuple((k, given[k]) for k in keys))
 
     def check(self, candidate: Candidate) -> tuple[Candidate, "Part"]:
-        """Build and check a candidate with this study's validity rules and material density."""
-        return check_candidate(candidate, self.validity, self.material.density_kg_per_m3)
+        """Build and check a candidate with this study's validity rules (mass from its material)."""
+        return check_candidate(candidate, self.validity)
 
     def candidate_of_row(self, row) -> Candidate:
         """The candidate a results-table row (one column per axis) belongs to."""
-        return self.candidate(**{a.key: type(a.values[0])(row[a.key]) for a in self.axes})
+        return self.candidate(**{a.key: row[a.key] if a.key == MATERIAL_KEY else
+                                 (float if a.continuous else type(a.values[0]))(row[a.key]) for a in self.axes})
 
     def _candidate(self, values: tuple[tuple[str, Value], ...]) -> Candidate:
-        origins = {f"geometry.{key}": f"design_space.{key}[{axis.values.index(v)}]"
+        origins = {f"geometry.{key}": f"design_space.{key}" + ("" if axis.continuous else f"[{axis.values.index(v)}]")
                    for axis, (key, v) in zip(self.axes, values)}
         params = read_geometry(Table(merged(self.fixed, values), self.path, "geometry", origins))
         if self.bearing_radius_mm > params.hub_radius_mm + 1e-9:
             raise ConfigError(f"{self.path}: bearing_radius_mm must not exceed geometry.hub_radius_mm "
                               "(it is read on the hub)")
-        return Candidate(values, params)
+        material = self.materials[dict(values).get(MATERIAL_KEY, next(iter(self.materials)))]
+        return Candidate(values, params, material)
 
 
 def _impact_lever(lc: Table, robot: Robot) -> float:
@@ -176,6 +190,22 @@ def _impact_lever(lc: Table, robot: Robot) -> float:
         warnings.warn(f"{lc.file}: load_cases.lower_leg_m is deprecated (it repeats robot.lower_leg_m, which the "
                       "impact torque now uses); remove it from the study file", FutureWarning, stacklevel=3)
     return robot.lower_leg_m
+
+
+def _materials(top: Table, axes: tuple[Axis, ...]) -> dict[str, Material]:
+    """The fixed material (top-level `material`), or each value of a `material` design axis."""
+    axis = next((a for a in axes if a.key == MATERIAL_KEY), None)
+    if axis is not None and "material" in top.data:
+        raise top.error("material", "is also a design axis (design_space.material); a key is either a design axis "
+                                    "or a fixed value: remove one of them")
+    names, where = (axis.values, "design_space.material") if axis else ((top.string("material"),), "material")
+    materials = {}
+    for name in names:
+        try:
+            materials[name] = load_material(name)
+        except ConfigError as exc:
+            raise top.error(where, f"cannot be loaded: {exc}") from None
+    return materials
 
 
 def _validity(top: Table) -> ValidityRules:
@@ -252,18 +282,17 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     top = Table(read_toml(path), path)
     name = top.string("name")
     description = top.string("description")
-    try:
-        material = load_material(top.string("material"))
-    except ConfigError as exc:
-        raise top.error("material", f"cannot be loaded: {exc}") from None
     bearing_radius_mm = top.number("bearing_radius_mm", gt=0)
     fixed = top.raw("geometry", None)
     if not isinstance(fixed, dict):
         raise top.error("geometry", "is missing or not a table; add [geometry] with the fixed dimensions (mm, deg)")
     axes = read_axes(top.table("design_space"), fixed)
     robot = _robot(top)
-    study = Study(name, description, path, material, axes, fixed, _validity(top), _load_cases(top, robot), robot,
-                  _actuator(top), _mesh(top), _ranking(top), bearing_radius_mm)
+    study = Study(name, description, path, _materials(top, axes), axes, fixed, _validity(top),
+                  _load_cases(top, robot), robot, _actuator(top), _mesh(top), _ranking(top), bearing_radius_mm)
     top.done()
-    study.candidates()  # every combination is checked now, so a bad value is named before any work starts
+    if all(not a.continuous for a in axes):
+        study.candidates()  # every combination is checked now, so a bad value is named before any work starts
+    else:
+        study.candidate(**{a.key: sum(a.bounds) / 2 if a.continuous else a.values[0] for a in axes})
     return study

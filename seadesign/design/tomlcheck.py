@@ -124,6 +124,15 @@ class Table:
             raise self.error(self.key(name), f"has repeated values {value!r}")
         return tuple(out)
 
+    def string_list(self, name: str) -> tuple[str, ...]:
+        """A non-empty list of distinct non-empty strings."""
+        value = self._get(name, _REQUIRED)
+        if not isinstance(value, list) or not value or not all(isinstance(v, str) and v.strip() for v in value):
+            raise self.error(self.key(name), f"must be a non-empty list of names, got {value!r}")
+        if len(set(value)) != len(value):
+            raise self.error(self.key(name), f"has repeated values {value!r}")
+        return tuple(value)
+
     def table(self, name: str, optional: bool = False) -> "Table | None":
         value = self._get(name, None if optional else _REQUIRED)
         if value is None:

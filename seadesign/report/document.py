@@ -32,8 +32,9 @@ def sections(study, t: pd.DataFrame, explanation: str, settings: dict) -> list[t
             counts[c] = counts.get(c, 0) + 1
     lc, rk = study.load_cases, study.ranking
     return [
-        ("Study", f"{study.name}: {study.description}. Material {study.material.name} "
-                  f"(E = {study.material.youngs_modulus_Pa / 1e6:.4g} MPa, yield {study.material.yield_strength_Pa / 1e6:.3g} MPa). "
+        ("Study", f"{study.name}: {study.description}. Material "
+                  + ", ".join(f"{m.name} (E = {m.youngs_modulus_Pa / 1e6:.4g} MPa, yield {m.yield_strength_Pa / 1e6:.3g} MPa)"
+                              for m in study.materials.values()) + ". "
                   f"Stall torque {lc.stall_torque_Nm:g} Nm on the hub; impact torque {lc.impact_torque_Nm:.2f} Nm on the "
                   f"backplate side; standing knee torque {study.robot.standing_knee_torque_Nm:.2f} Nm. "
                   f"Mesh: {study.mesh.elements_across_beam:g} elements across a beam ({study.mesh.backend})."),

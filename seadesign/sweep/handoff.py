@@ -32,7 +32,8 @@ def load_case_block(row: pd.Series, case: str) -> dict[str, float]:
 def spring_document(study: Study, row: pd.Series, inputs_hash: str, versions: dict[str, str],
                     selection: dict) -> dict:
     """The spring.json content of a chosen, solved candidate (validated by design.spring.write_spring)."""
-    params = study.candidate_of_row(row).params
+    candidate = study.candidate_of_row(row)
+    params = candidate.params
     a, lc, r = study.actuator, study.load_cases, study.robot
     limit = study.ranking.small_deflection_limit_rad
     return {
@@ -42,7 +43,7 @@ def spring_document(study: Study, row: pd.Series, inputs_hash: str, versions: di
         "k_Nm_per_rad": float(row["k_Nm_per_rad"]),
         "k_rel_error": _number(row["k_rel_error"]),
         "design": dataclasses.asdict(params),
-        "material": study.material.to_handoff(),
+        "material": candidate.material.to_handoff(),
         "actuator": {
             "stall_torque_Nm": lc.stall_torque_Nm,
             "no_load_speed_rad_per_s": a.no_load_speed_rpm * 2 * math.pi / 60,

@@ -78,15 +78,17 @@ def _thesis_result(study: Study, row: pd.Series) -> tuple[float, float]:
 
 def constraint_columns(t: pd.DataFrame, study: Study) -> pd.DataFrame:
     """One boolean column per hard constraint, `feasible`, and `failed_constraints` in words."""
-    rk, m = study.ranking, study.material
-    allowable_MPa = m.yield_strength_Pa / rk.safety_factor * 1e-6
+    rk = study.ranking
+    allowable = pd.Series([study.candidate_of_row(r).material.yield_strength_Pa / rk.safety_factor * 1e-6
+                           for _, r in t.iterrows()], index=t.index, dtype=float)
+    limit = f"{allowable.iloc[0]:.3g} MPa" if allowable.nunique() == 1 else "yield / safety factor"
     solved = t["status"] == "ok"
     col = t.reindex(columns=["stall_von_mises_max_MPa", "impact_von_mises_max_MPa"])
     checks = {
         "valid geometry": t["status"] != "invalid",
         "solved": t["status"] != "failed",
-        f"stall stress < {allowable_MPa:.3g} MPa": solved & (col["stall_von_mises_max_MPa"] < allowable_MPa),
-        f"impact stress < {allowable_MPa:.3g} MPa": solved & (col["impact_von_mises_max_MPa"] < allowable_MPa),
+        f"stall stress < {limit}": solved & (col["stall_von_mises_max_MPa"] < allowable),
+        f"impact stress < {limit}": solved & (col["impact_von_mises_max_MPa"] < allowable),
         f"standing deflection < {rk.max_standing_deflection_deg:g} deg":
             solved & (t["standing_deflection_deg"] < rk.max_standing_deflection_deg),
     }
@@ -95,7 +97,7 @@ def constraint_columns(t: pd.DataFrame, study: Study) -> pd.DataFrame:
     if rk.k_max_Nm_per_rad is not None:
         checks[f"k <= {rk.k_max_Nm_per_rad:g} Nm/rad"] = solved & (t["k_Nm_per_rad"] <= rk.k_max_Nm_per_rad)
     t = t.copy()
-    t["allowable_stress_MPa"] = allowable_MPa
+    t["allowable_stress_MPa"] = allowable
     gate = {"valid geometry": pd.Series(True, index=t.index), "solved": t["status"] != "invalid"}
     fails = pd.DataFrame({name: gate.get(name, solved) & ~ok.fillna(False).astype(bool) for name, ok in checks.items()})
     t["failed_constraints"] = ["; ".join(c for c in fails.columns if row[c]) for _, row in fails.iterrows()]

@@ -66,7 +66,7 @@ def row_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str
     """Hash of every input of one candidate's row (its axis values, geometry, mesh, material, loads,
     solver, versions)."""
     return digest("row", candidate.values, fea_key(study, candidate, settings), geometry_key(study, candidate),
-                  study.load_cases, study.bearing_radius_mm, study.material)
+                  study.load_cases, study.bearing_radius_mm, candidate.material)
 
 
 def evaluate(job: Job, sink) -> dict:
@@ -155,6 +155,6 @@ def sweep_settings(study: Study, settings: SolverSettings) -> dict:
     """Settings and versions recorded next to the results."""
     from dataclasses import asdict
 
-    return {"study": study.name, "study_file": str(study.path), "material": study.material.name,
-            "youngs_modulus_Pa": study.material.youngs_modulus_Pa, "mesh": asdict(study.mesh),
+    return {"study": study.name, "study_file": str(study.path),
+            "materials": {k: asdict(m) for k, m in study.materials.items()}, "mesh": asdict(study.mesh),
             "solver": asdict(settings), "ranking": asdict(study.ranking), "versions": package_versions()}

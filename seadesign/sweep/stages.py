@@ -77,7 +77,7 @@ def mesh_key(study: Study, candidate: Candidate) -> str:
 def fea_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
     """Inputs of the unit response: the mesh, the material, the solver settings, and the code of
     this module with everything it imports (the solver, the mesher, the study's mesh sizing)."""
-    m = study.material
+    m = candidate.material
     return digest("fea", mesh_key(study, candidate), m.youngs_modulus_Pa, m.poisson_ratio,
                   settings.element_order, settings.linear_solver,
                   code_fingerprint("seadesign.sweep.stages", "seadesign.mesh.worker"), package_versions())
@@ -89,7 +89,7 @@ def check_geometry(study: Study, candidate: Candidate, cache: Cache) -> tuple[Ca
     hit = cache.get("geometry", key)
     if hit is not None:
         reasons, volume_mm3 = hit
-        return candidate.with_geometry(reasons, volume_mm3, study.material.density_kg_per_m3), None
+        return candidate.with_geometry(reasons, volume_mm3), None
     checked, part = study.check(candidate)
     cache.put("geometry", key, (checked.reasons, checked.volume_mm3))
     return checked, part
@@ -105,13 +105,13 @@ def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache,
                      cache_dir=Path(cache.root) / "mesh", **study.mesh.scaled(1.0 / coarsening).mesh_part_options())
 
 
-def unit_response(mesh, coarse_mesh, study: Study, settings: SolverSettings) -> UnitResponse:
+def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, settings: SolverSettings) -> UnitResponse:
     """Both load cases at 1 Nm, and k on the coarse mesh for the error estimate."""
     from seadesign.fea.loadcases import analyse
     from seadesign.fea.stress import invariants
     from seadesign.fea.torsion import solve_unit_torsion
 
-    m = study.material
+    m = candidate.material
     t0 = time.perf_counter()
     a = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, 1.0, 1.0, study.bearing_radius_mm,
                 order=settings.element_order, linear_solver=settings.linear_solver)
@@ -149,6 +149,6 @@ def fea_response(study: Study, candidate: Candidate, part: Part | None, settings
     mesh = tetrahedralize(study, candidate, part, cache)
     coarse_mesh = tetrahedralize(study, candidate, part, cache, COARSENING)
     progress("fea")
-    unit = unit_response(mesh, coarse_mesh, study, settings)
+    unit = unit_response(mesh, coarse_mesh, study, candidate, settings)
     cache.put("fea", fkey, unit)
     return unit
