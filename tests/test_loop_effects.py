@@ -168,37 +168,3 @@ def test_ripple_outside_the_library_is_reported_not_mislabelled():
     assert not ex.tests_after["white"]
     assert ex.tests_after["autocorrelation"]["structured"]
     assert "Structure is left" in ex.verdict()
-
-
-@pytest.mark.parametrize("c, softest, rtol", [(1e-3, 0.85, 0.01), (3e-3, 0.4, 0.03)])
-def test_compliance_softening_matches_the_effect_library(c, softest, rtol):
-    """softening_from_compliance sees only the torque and torque / k; the stiffness factor it returns must
-    match the one the library's per-sample ThermalSoftening applied: within 1 % at a quarter of softening,
-    3 % at two thirds (where a whole-record fixed point diverges)."""
-    from seadesign.effects import ThermalSoftening
-    from seadesign.loop.candidates import softening_from_compliance
-
-    t = np.arange(12000) / 100.0
-    d = 0.5 * np.sin(2 * np.pi * 0.5 * t)
-    torque = ThermalSoftening().apply({"deflection": d, "torque": K * d, "time": t},
-                                      {"softening_per_K": c, "loss_factor": 1.0, "heat_capacity_J_per_K": 1.0,
-                                       "cooling_time_s": 300.0})
-    f = softening_from_compliance(torque / K, torque, 0.01, c, 300.0)
-    moving = np.abs(d) > 0.1
-    truth = torque[moving] / (K * d[moving])
-    assert truth.min() < softest  # the case softens as stated
-    np.testing.assert_allclose(f[moving], truth, rtol=rtol)
-
-
-@pytest.mark.parametrize("torque, stiffness", [(0.3, 50.0), (0.03, 500.0), (0.0066, 30.0), (1.0, 0.5)])
-def test_vectorised_dahl_equals_the_effect_library(torque, stiffness):
-    """The loop's block-wise Dahl solution against the library's per-sample recursion, on a sine with a
-    random walk (many small reversals), from slow to instant saturation."""
-    from seadesign.effects import DahlHysteresis
-    from seadesign.loop.candidates import dahl
-
-    t = np.arange(20000) / 100.0
-    d = 0.5 * np.sin(2 * np.pi * 0.3 * t) + np.cumsum(np.random.default_rng(0).normal(0, 0.003, t.size))
-    ref = DahlHysteresis().apply({"deflection": d, "torque": np.zeros_like(d)},
-                                 {"torque_Nm": torque, "stiffness_Nm_per_rad": stiffness})
-    np.testing.assert_allclose(dahl(d, torque, stiffness), ref, rtol=0, atol=1e-12 * torque)
