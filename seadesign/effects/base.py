@@ -43,6 +43,7 @@ SIGNALS: dict[str, tuple[str, str]] = {
     "hall": ("rad", "Hall sensor reading of the link angle"),
     "motor": ("rad", "motor encoder reading"),
     "motor_velocity": ("rad/s", "motor output angular velocity"),
+    "hall_velocity": ("rad/s", "finite difference of the Hall reading (as the robot logs it)"),
     "effort": ("Nm", "torque the servo reports (from its current)"),
     "temperature": ("degC", "measured spring temperature (optional)"),
     "energy": ("J", "cumulative dissipated energy (optional)"),
@@ -194,7 +195,7 @@ class Effect:
         search may leave the physical bounds where a table's sign convention is unknown."""
         p = {**self.values, **values}
         x = self._inputs(signals)
-        return self._apply_stateful(x, p) if self.stateful else self._map(x, p, _rng(None))
+        return self._apply_stateful(x, p) if self.stateful else self._map(x, p, None if not self.random else _rng(None))
 
     def init_state(self, sample: Signals, params: Mapping[str, float] | None = None) -> dict[str, Any]:
         """State before the first step, from the first sample (batch-shaped arrays)."""

@@ -1,0 +1,207 @@
+"""Where each library effect acts in the loop's model, and the model's evaluation over whole records.
+
+A `Term` is a named library effect (`seadesign.effects`) in a model; its parameters are the
+effect's, with the effect's names and units. `PLACES` says where an effect acts:
+
+- `sensor`: on the measured reading (or, with `sensor_on="deflection"`, on the deflection reading
+  the model reads, undone there): offset, step, drift, delay;
+- `effort` (compliance direction with an effort signal): the servo's effort is undone into the
+  spring torque: its lag (`EffortLag.torque_from_effort`) and the gear friction on the motor side;
+- `deflection`: dead-band or backlash (`DeadBand`; in the compliance direction its free travel);
+- `spring`: the spring law: `stiffness_scale` (the declared k, always refitted), cubic stiffening,
+  hysteresis, viscoelasticity (torque terms; in the compliance direction inverted: a Newton solve of
+  the cubic, the inverse of the standard-linear-solid filter, the Dahl term over k), thermal and
+  temperature softening (factors; thermal in the compliance direction marched in time);
+- `load` (stiffness direction): friction against `velocity`, gravity against `angle`.
+
+Stateful effects read the Savitzky-Golay smoothed deflection (`LoopData.smooth`), so sensor noise
+does not act as many tiny reversals; the fitter's filters run at the median sample interval.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from seadesign.effects import LIBRARY, Effect
+from seadesign.effects.spring import dahl, leaky_sum, sls_deflection, softening_from_compliance, solve_cubic
+from seadesign.loop.table import LoopData, smooth
+
+PLACES: dict[str, str] = {
+    "sensor_delay": "sensor", "sensor_offset": "sensor", "sensor_step": "sensor", "sensor_drift": "sensor",
+    "effort_lag": "effort", "friction": "load", "dead_band": "deflection",
+    "stiffness_scale": "spring", "cubic_stiffening": "spring", "hysteresis": "spring", "viscoelastic": "spring",
+    "thermal_softening": "spring", "temperature_softening": "spring", "gravity": "load",
+}
+#: order of the effects within the model (the simulator's order in its chain)
+ORDER = ("effort_lag", "friction", "dead_band", "stiffness_scale", "cubic_stiffening", "hysteresis", "viscoelastic",
+         "thermal_softening", "temperature_softening", "gravity", "sensor_delay", "sensor_offset", "sensor_step",
+         "sensor_drift")
+#: effects the loop can trace as candidates (library keys); the spring itself is declared, not traced
+CANDIDATES = tuple(k for k in ORDER if k != "stiffness_scale")
+#: effects whose value at a sample needs the whole record (history or neighbours); a model without them is
+#: evaluated on the fitted rows alone (`LoopData.subset`)
+WHOLE_RECORD = frozenset({"hysteresis", "viscoelastic", "thermal_softening", "sensor_delay"})
+
+
+@dataclass(frozen=True)
+class Term:
+    """A library effect in a model under a unique `name`; `declared`: given by the model (spring.json or
+    the actuator data), so refitted from its values and tested for support, rather than traced."""
+
+    name: str
+    effect: Effect
+    declared: bool = False
+
+    @property
+    def key(self) -> str:
+        return self.effect.key
+
+
+def place(term: Term, data: LoopData) -> str:
+    """Where `term` acts on `data`: friction acts on the effort when the data has one (gear friction)."""
+    if term.key == "friction" and data.direction == "compliance" and "effort" in data.signals:
+        return "effort"
+    return PLACES[term.key]
+
+
+def applicable(key: str, data: LoopData) -> bool:
+    """Whether the library effect `key` can act on `data` (its signals are there, its place exists)."""
+    s, comp = data.signals, data.direction == "compliance"
+    need = {
+        "effort_lag": comp and "effort" in s,
+        "friction": ("motor_velocity" in s and "effort" in s) if comp else "velocity" in s,
+        "gravity": not comp and "angle" in s,
+        "temperature_softening": "temperature" in s,
+        "stiffness_scale": data.spring is not None or np.ptp(data.predicted) > 0,
+    }
+    spring_terms = ("dead_band", "cubic_stiffening", "hysteresis", "viscoelastic", "thermal_softening")
+    if key in spring_terms:
+        return comp or "deflection" in s
+    return need.get(key, key in LIBRARY)
+
+
+def ordered(terms: list[Term]) -> list[Term]:
+    return sorted(terms, key=lambda t: ORDER.index(t.key))
+
+
+def predict(data: LoopData, terms: list[Term], values: dict[str, dict[str, float]]) -> np.ndarray:
+    """The model's prediction of `data.measured` with `terms` at `values` (term name -> parameter -> value)."""
+    terms = ordered(terms)
+    at = {p: [t for t in terms if place(t, data) == p] for p in ("sensor", "effort", "deflection", "spring", "load")}
+    if data.direction == "compliance":
+        y = data.base + data.sign * _deflection(data, at, values) if data.base is not None else \
+            data.sign * _deflection(data, at, values)
+    else:
+        y = _torque(data, at, values)
+    if data.sensor_on == "measured":
+        for t in at["sensor"]:
+            y = t.effect.evaluate({"hall": y, "time": data.time}, values[t.name])
+    return y
+
+
+def _sensor_inverse(data: LoopData, terms: list[Term], values, d: np.ndarray) -> np.ndarray:
+    """The true deflection from a reading with the sensor effects `terms`: each undone, last first."""
+    for t in reversed(terms):
+        p = values[t.name]
+        if t.key == "sensor_delay":
+            d = np.interp(data.time + p["delay_s"], data.time, d)
+        else:  # additive: offset, step, drift with the opposite sign
+            d = t.effect.evaluate({"hall": d, "time": data.time}, {k: (-v if k != "time_s" else v) for k, v in p.items()})
+    return d
+
+
+def _path(data: LoopData, d: np.ndarray) -> np.ndarray:
+    """The spring path at deflection d: the spring's torque, or on a generic table the slope times d."""
+    if data.spring is not None:
+        return data.spring.apply({"deflection": d})
+    return data.gain * d
+
+
+def _torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
+    """Stiffness direction: deflection -> (sensor undone) -> dead-band -> spring law -> + loads."""
+    s = data.signals
+    d0 = s.get("deflection")
+    path0 = data.predicted if data.predicted is not None else _path(data, d0)
+    d, path = d0, path0
+    if data.sensor_on == "deflection" and at["sensor"]:
+        d = _sensor_inverse(data, at["sensor"], values, d0)
+        path = path0 + _path(data, d) - _path(data, d0)
+    for t in at["deflection"]:
+        banded = t.effect.evaluate({"deflection": d}, values[t.name])
+        path, d = path + _path(data, banded) - _path(data, d), banded
+    stateful = {"hysteresis", "viscoelastic", "thermal_softening"} & {t.key for t in at["spring"]}
+    ds = None if not stateful else smooth(d, data.time) if d is not d0 else data.smooth("deflection")
+    tau, factor = path, 1.0
+    for t in at["spring"]:
+        p = values[t.name]
+        if t.key == "stiffness_scale":
+            tau = tau * p["scale"]
+        elif t.key == "cubic_stiffening":
+            tau = tau + p["k3_Nm_per_rad3"] * d ** 3
+        elif t.key == "hysteresis":
+            tau = tau + dahl(ds, p["torque_Nm"], p["stiffness_Nm_per_rad"])
+        elif t.key == "viscoelastic":
+            tau = tau + t.effect.evaluate({"deflection": ds, "time": data.time, "torque": np.zeros_like(ds)}, p)
+        elif t.key == "thermal_softening":
+            factor = factor * _thermal_factor(data, p, lambda: path * np.diff(ds, prepend=ds[0]))
+        else:  # temperature_softening
+            factor = factor * t.effect.evaluate({"temperature": s["temperature"], "torque": np.ones(data.n)}, p)
+    y = tau * factor + ((data.predicted - path0) if data.predicted is not None else 0.0)
+    for t in at["load"]:
+        y = t.effect.evaluate({**s, "load_torque": y}, values[t.name])
+    return y
+
+
+def _thermal_factor(data: LoopData, p: dict[str, float], power) -> np.ndarray:
+    if "energy" in data.signals:
+        e = data.signals["energy"]
+        return np.maximum(1.0 - p["softening_per_J"] * (e - e[0]), 0.05)
+    heat = leaky_sum(np.abs(power()), data.dt, p["cooling_time_s"])
+    return np.maximum(1.0 - p["softening_per_J"] * heat, 0.05)
+
+
+def spring_torque(data: LoopData, at: dict[str, list[Term]], values, smoothed: bool = False) -> np.ndarray:
+    """Compliance direction: the spring torque from the torque or effort signal, the effort's lag and gear
+    friction undone; `smoothed`: from the smoothed signals (for a dead-band's side and the stateful effects)."""
+    role = "torque" if "torque" in data.signals else "effort"
+    tau = data.smooth(role) if smoothed else data.input_torque
+    for t in at["effort"]:
+        p = values[t.name]
+        if t.key == "effort_lag":
+            tau = tau + p["time_constant_s"] * data.rate("effort")
+        else:  # gear friction on the motor side, in the effort
+            e, v = t.effect, data.smooth("motor_velocity") if smoothed else data.signals["motor_velocity"]
+            tau = tau - e.evaluate({e.signal("velocity"): v, e.signal("load_torque"): np.zeros(data.n)}, p)
+    return tau
+
+
+def _deflection(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
+    """Compliance direction: torque -> spring law inverted -> deflection -> free travel of the dead-band."""
+    tau = spring_torque(data, at, values)
+    spring = [t for t in at["spring"] if t.key == "stiffness_scale"]
+    scale = values[spring[0].name]["scale"] if spring else 1.0
+    k = data.gain * scale
+    curve = hasattr(data.spring, "curve")
+    x = data.spring.rotation(tau, scale) if curve else tau / k
+    xs = x
+    if any(t.key != "stiffness_scale" for t in at["spring"]) or at["deflection"]:
+        tau_s = spring_torque(data, at, values, smoothed=True)
+        xs = data.spring.rotation(tau_s, scale) if curve else tau_s / k
+    for t in at["spring"]:
+        p = values[t.name]
+        if t.key == "cubic_stiffening":  # k d + k3 d^3 = k x
+            x = solve_cubic(x, p["k3_Nm_per_rad3"] / k)
+        elif t.key == "hysteresis":
+            x = x - dahl(xs, p["torque_Nm"], p["stiffness_Nm_per_rad"]) / k
+        elif t.key == "viscoelastic":
+            x = sls_deflection(x, data.dt, p["maxwell_stiffness_Nm_per_rad"] / k, p["relaxation_time_s"])
+        elif t.key == "thermal_softening":
+            x = x / (softening_from_compliance(xs, tau_s, data.dt, p["softening_per_J"], p["cooling_time_s"])
+                     if "energy" not in data.signals else _thermal_factor(data, p, None))
+        elif t.key == "temperature_softening":
+            x = x / t.effect.evaluate({"temperature": data.signals["temperature"], "torque": np.ones(data.n)}, p)
+    for t in at["deflection"]:  # the free travel, its side from the smoothed deflection
+        x = x + t.effect.free_travel(xs, values[t.name]["width_rad"]) - xs
+    return x
