@@ -11,7 +11,7 @@ used two ways:
 What a fitter needs besides: `search(scales)` (bounds and start points that depend on the data,
 `Scales`), `log_params` (positive scale parameters searched in log space), `evaluate` (apply with
 unchecked trial values), and the inverse pieces of the compliance direction (`solve_cubic`,
-`sls_deflection`, `softening_from_compliance`, `DeadBand.free_travel`, `EffortLag.torque_from_effort`,
+`sls_deflection`, `softening_marched`, `DeadBand.free_travel`, `EffortLag.torque_from_effort`,
 `SpringCurve.rotation`).
 
 `EffectChain` orders effects and runs them (`run` over arrays, `start`/`step` in time).

@@ -68,8 +68,8 @@ class Scales:
 
     `deflection_rad` largest |deflection|, `torque_Nm` largest |spring torque|, `velocity_rad_per_s`
     90 % quantile of the |velocity| that drives friction, `duration_s` record length, `dt_s` median
-    sample interval, `k_Nm_per_rad` slope of the spring, `measured_span` span of the measured channel
-    (in its unit). Names carry the SEA units; on a generic table they stand for the table's units.
+    sample interval, `k_Nm_per_rad` slope of the spring, `measured_span` span of the reading the sensor
+    effects act on (the measured channel, or a bench's deflection reading; in its unit). Names carry the SEA units; on a generic table they stand for the table's units.
     """
 
     deflection_rad: float = 1.0

@@ -202,5 +202,5 @@ class EffortLag(Effect):
         return effort + time_constant_s * effort_rate
 
     def search(self, s: Scales) -> Search:
-        return ({"time_constant_s": (1e-4, 1.0)},
+        return ({"time_constant_s": (0.5 * s.dt_s, 1.0)},
                 [{"time_constant_s": te} for te in (0.01, 0.05, 0.2)])

@@ -4,7 +4,7 @@ Order in a chain: dead zones act on `deflection` first, then the spring (`Linear
 large-deflection `SpringCurve`, see `curve.py`) turns it into `torque`, then the torque effects add
 or scale. Each effect's whole-array model is vectorised (`apply`); a fitter that predicts the
 deflection from a torque (the compliance direction) uses the inverse pieces defined here:
-`solve_cubic`, `sls_deflection`, `softening_from_compliance`, `DeadBand.free_travel`.
+`solve_cubic`, `sls_deflection`, `softening_marched`, `DeadBand.free_travel`.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import math
 import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 
-from seadesign.effects.base import Effect, Param, Scales, Search, lowpass, rows, time_steps, uniform_step
+from seadesign.effects.base import Effect, Param, Scales, Search, lowpass, rows, time_steps
 
 
 class DeadBand(Effect):
@@ -215,7 +215,10 @@ class Viscoelastic(Effect):
         return x["torque"] + p["maxwell_stiffness_Nm_per_rad"] * (x["deflection"] - relaxed)
 
     def search(self, s: Scales) -> Search:
-        return ({"maxwell_stiffness_Nm_per_rad": (0.0, 10.0 * s.k_Nm_per_rad), "relaxation_time_s": (1e-3, 1e3)},
+        # relaxation faster than 0.1 s or ten samples is not told from a filter of the noise, one slower than half the
+        # record is a stiffness and an offset
+        return ({"maxwell_stiffness_Nm_per_rad": (0.0, 10.0 * s.k_Nm_per_rad),
+                 "relaxation_time_s": (max(10 * s.dt_s, 0.1), max(0.5 * s.duration_s, 0.2))},
                 [{"maxwell_stiffness_Nm_per_rad": 0.1 * s.k_Nm_per_rad, "relaxation_time_s": tr} for tr in (0.05, 0.5, 5.0)])
 
 
@@ -224,49 +227,49 @@ def leaky_sum(h: np.ndarray, dt: float, tau: float) -> np.ndarray:
     return lfilter([1.0], [1.0, -math.exp(-dt / tau)], h)
 
 
-def softening_from_compliance(x: np.ndarray, torque: np.ndarray, dt: float, c: float, tc: float,
-                              chunk: int = 25) -> np.ndarray:
-    """Stiffness factor f per sample of `ThermalSoftening` when only the torque (Nm) and x = torque / k
-    (rad) are known (the compliance direction).
+def softening_marched(work: np.ndarray, dt: float, c: float, tc: float, compliance: bool,
+                      chunk: int = 25) -> np.ndarray:
+    """Stiffness factor f per sample of `ThermalSoftening`, marched in chunks of `chunk` samples at a uniform
+    sample interval dt (s), f constant within a chunk and solved implicitly there (closed form).
 
-    The spring heats by |k d dd| with the true deflection d = x / f, i.e. by q / f^2 with
-    q = |torque dx|, and f = 1 - c H with H the heat (J) cooling with time constant tc (s). H
-    depends on f, which a whole-record fixed point cannot resolve once softening passes a third,
-    so the record is marched in chunks of `chunk` samples with f constant in each, solved
-    implicitly (Newton on f = 1 - c (H_start a^m + S / f^2)); f is floored at 0.05.
+    `work` per sample: |torque dd| with the torque of the unsoftened spring (stiffness direction, where the
+    deflection d is known: the spring takes f times that) or |torque dx| with x = torque / k (compliance
+    direction, where the torque is known and the true deflection is x / f: the spring takes that over f).
+    With H_s the heat carried into a chunk and S its work: f = 1 - c (H_s + S f), or f = 1 - c (H_s + S / f)
+    (the larger root of f^2 - (1 - c H_s) f + c S = 0; none: the spring runs away, f = 0.05). The
+    chunking keeps it stable where a whole-record fixed point diverges (past a third of softening).
     """
     a = math.exp(-dt / tc)
-    q = np.abs(torque * np.diff(x, prepend=x[0]))
-    filled = lfilter([1.0], [1.0, -a], q)
-    ends = np.append(np.arange(chunk - 1, x.size - 1, chunk), x.size - 1)
+    filled = leaky_sum(work, dt, tc)
+    ends = np.append(np.arange(chunk - 1, work.size - 1, chunk), work.size - 1)
     per_chunk = np.empty(ends.size)
-    heat, f, prev = 0.0, 1.0, -1
-    for j, e in enumerate(ends):
+    heat, prev = 0.0, -1
+    for j, e in enumerate(ends.tolist()):
         decay = a ** (e - prev)
         start = heat * decay
         gained = filled[e] - (decay * filled[prev] if prev >= 0 else 0.0)
-        for _ in range(8):
-            slope = 1.0 - 2.0 * c * gained / f ** 3
-            if slope <= 0.0:  # past the turning point: no stiffness carries this heat, the spring runs away
-                f = 0.05
-                break
-            change = (f - 1.0 + c * (start + gained / f ** 2)) / slope
-            f = min(max(f - change, 0.05), 1.0)
-            if abs(change) < 1e-12:
-                break
-        heat, prev = start + gained / f ** 2, e
+        left = 1.0 - c * start
+        if compliance:
+            disc = left * left - 4.0 * c * gained
+            f = 0.5 * (left + math.sqrt(disc)) if disc >= 0 and left > 0 else 0.05
+        else:
+            f = left / (1.0 + c * gained)
+        f = min(max(f, 0.05), 1.0)
+        heat, prev = start + gained * (1.0 / f if compliance else f), e
         per_chunk[j] = f
     f_chunk = np.repeat(per_chunk, np.diff(np.concatenate([[-1], ends])))
-    return np.maximum(1.0 - c * lfilter([1.0], [1.0, -a], q / f_chunk ** 2), 0.05)
+    taken = work / f_chunk if compliance else work * f_chunk
+    return np.maximum(1.0 - c * leaky_sum(taken, dt, tc), 0.05)
 
 
 class ThermalSoftening(Effect):
-    """Stiffness falls with the heat the spring keeps: torque *= 1 - c H, floored at 0.05.
+    """Stiffness falls with the heat the spring keeps: torque *= f = 1 - c H, floored at 0.05.
 
-    H' = |torque d'| - H / tc: the mechanical power through the spring heats it and it cools with
-    time constant tc. c = a eta / C folds the relative stiffness loss a per kelvin, the share eta of
-    the power lost as heat and the heat capacity C (J/K) into the one gain that data can identify
-    (e.g. a = 0.01 /K, eta = 0.1, C = 15 J/K: c = 6.7e-5 /J).
+    H' = |torque d'| - H / tc: the mechanical power the spring takes (its softened torque times its
+    deflection rate) heats it, and it cools with time constant tc. c = a eta / C folds the relative
+    stiffness loss a per kelvin, the share eta of the power lost as heat and the heat capacity C (J/K)
+    into the one gain that data can identify (e.g. a = 0.01 /K, eta = 0.1, C = 15 J/K: c = 6.7e-5 /J).
+    Per sample, implicitly: H_n = H_{n-1} exp(-dt/tc) + f_n |t_n dd_n| with t_n the unsoftened torque.
     """
 
     key = "thermal_softening"
@@ -285,28 +288,29 @@ class ThermalSoftening(Effect):
         return {"heat": np.zeros_like(x["deflection"]), "d": x["deflection"].copy()}
 
     def _advance(self, state, x, dt, p):
-        d, tau = x["deflection"], x["torque"]
-        state["heat"] = state["heat"] * math.exp(-dt / p["cooling_time_s"]) + np.abs(tau * (d - state["d"]))
+        d, tau, c = x["deflection"], x["torque"], p["softening_per_J"]
+        kept = state["heat"] * math.exp(-dt / p["cooling_time_s"])
+        work = np.abs(tau * (d - state["d"]))
+        f = np.maximum((1.0 - c * kept) / (1.0 + c * work), 0.05)
+        state["heat"] = kept + f * work
         state["d"] = d.copy()
-        return tau * np.maximum(1.0 - p["softening_per_J"] * state["heat"], 0.05)
+        return tau * f
 
     def _apply_stateful(self, x, p):
         c, tc = p["softening_per_J"], p["cooling_time_s"]
         d, tau = np.broadcast_arrays(x["deflection"], x["torque"])
-        power = np.abs(tau * np.diff(d, axis=-1, prepend=d[..., :1]))
-        dt = uniform_step(x["time"])
-        if dt is not None:
-            heat = lfilter([1.0], [1.0, -math.exp(-dt / tc)], power, axis=-1)
-        else:
-            heat = np.empty(power.shape)
-            flat = heat.reshape(-1, heat.shape[-1])
-            for i, (ps, dts) in enumerate(rows(power, time_steps(x["time"]))):
-                h, hs = 0.0, []
-                for pw, step in zip(ps, dts):
-                    h = h * math.exp(-step / tc) + pw
-                    hs.append(h)
-                flat[i] = hs
-        return tau * np.maximum(1.0 - c * heat, 0.05)
+        out = np.empty(np.broadcast_shapes(d.shape, np.shape(x["time"])))
+        flat = out.reshape(-1, out.shape[-1])
+        for i, (ds, ts, dts) in enumerate(rows(d, tau, time_steps(x["time"]))):
+            heat, prev, ys = 0.0, ds[0], []
+            for dv, tv, step in zip(ds, ts, dts):
+                kept = heat * math.exp(-step / tc)
+                work = abs(tv * (dv - prev))
+                f = max((1.0 - c * kept) / (1.0 + c * work), 0.05)
+                heat, prev = kept + f * work, dv
+                ys.append(tv * f)
+            flat[i] = ys
+        return out
 
     def search(self, s: Scales) -> Search:
         return ({"softening_per_J": (0.0, 1.0), "cooling_time_s": (1.0, 1e6)},

@@ -28,7 +28,7 @@ from scipy.optimize import least_squares
 from seadesign.effects import Param
 from seadesign.loop.metrics import split_metrics
 from seadesign.loop.table import LoopData
-from seadesign.loop.terms import WHOLE_RECORD, Term, predict
+from seadesign.loop.terms import Term, predict, whole_record
 
 MAX_FIT_ROWS = 8000
 
@@ -131,7 +131,7 @@ class EffectModel:
         n = int(train.sum())
         rows = np.flatnonzero(train)[:: max(1, -(-n // MAX_FIT_ROWS))]
         y = data.measured[rows]
-        pointwise = not any(t.key in WHOLE_RECORD for t in self.terms)
+        pointwise = not whole_record(self.terms, data)
         sub = data.subset(rows) if pointwise else data
         warm = warm or {}
         combos = [[[warm[t.name][p.name] for p in t.effect.parameters]] if t.name in warm else opts
@@ -156,8 +156,8 @@ class EffectModel:
                 x0 = np.clip(np.concatenate([np.asarray(c, float) for c in combo]) if combo else lo, lo, hi)
                 u0 = to_u(x0)[free]
                 u0 = np.clip(u0, ulo + 1e-9 * (uhi - ulo), uhi - 1e-9 * (uhi - ulo))
-                res = least_squares(resid, u0, bounds=(ulo, uhi), x_scale="jac", method="trf", tr_solver="lsmr",
-                                    max_nfev=100 * len(u0))
+                res = least_squares(resid, u0, bounds=(ulo, uhi), x_scale="jac", method="trf", max_nfev=100 * len(u0),
+                                    tr_solver="lsmr" if len(u0) > 1 else "exact")  # lsmr's 2-D subspace needs 2
                 if best is None or res.cost < best.cost:
                     best = res
             x_best = full(best.x)

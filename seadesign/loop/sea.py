@@ -6,7 +6,8 @@ one (`SpringCurve`, PCHIP): the model's spring either way, its stiffness scale a
 
 - Bench, `torque` (default): measured torque_Nm from the deflection_rad reading (stiffness direction;
   sensor effects act on the deflection reading); signals time, deflection, temperature when present.
-- Bench, `deflection`: measured deflection_rad from torque_Nm (compliance direction).
+- Bench, `deflection`: measured deflection_rad from torque_Nm (compliance direction); the bench's friction
+  acts against the deflection rate.
 - Robot, one knee (flexion positive, the right knee un-mirrored, `seadesign.data.knee_channels`):
   measured Hall angle = motor angle - deflection, the deflection from the effort through the
   declared effects (compliance direction): gear friction on the motor side taken off the effort, the
@@ -23,7 +24,7 @@ import pandas as pd
 from seadesign.data import knee_channels
 from seadesign.effects import DeadBand, Effect, Friction, LinearSpring, SpringCurve, TorqueCurve
 from seadesign.loop.engine import Explanation
-from seadesign.loop.table import LoopData, LoopInputError
+from seadesign.loop.table import LoopData, LoopInputError, smooth_rate
 from seadesign.twin.config import GEAR_COULOMB_NM
 
 #: the robot model's declared effects: library key -> name in the model
@@ -55,7 +56,7 @@ def bench_loop_data(df: pd.DataFrame, spring: dict[str, Any], predict: str = "to
     """LoopData of a bench table (`read_bench`) with the spring of spring.json; `predict` torque or deflection."""
     time, torque, defl = (df[c].to_numpy(float) for c in ("time_s", "torque_Nm", "deflection_rad"))
     signals = {"time": time}
-    units = {"time": "s", "deflection": "rad", "temperature": "degC", "torque": "Nm"}
+    units = {"time": "s", "deflection": "rad", "temperature": "degC", "torque": "Nm", "velocity": "rad/s"}
     columns = {"time": "time_s"}
     if "temperature_C" in df.columns:
         signals["temperature"] = df["temperature_C"].to_numpy(float)
@@ -65,9 +66,13 @@ def bench_loop_data(df: pd.DataFrame, spring: dict[str, Any], predict: str = "to
                         sensor_on="deflection", measured_name="torque_Nm", measured_unit="Nm", units=units,
                         columns={**columns, "deflection": "deflection_rad", "measured": "torque_Nm"})
     if predict == "deflection":
-        return LoopData(defl, {**signals, "torque": torque}, "compliance", spring=model_spring(spring),
+        # the bench's friction acts against the deflection rate: from the reading (the torque's rate would carry the
+        # friction's own jump); a Savitzky-Golay derivative, whose kernel leaves out the sample itself
+        rate = smooth_rate(defl, time)
+        return LoopData(defl, {**signals, "torque": torque, "velocity": rate}, "compliance", spring=model_spring(spring),
                         measured_name="deflection_rad", measured_unit="rad", units=units,
-                        columns={**columns, "torque": "torque_Nm", "measured": "deflection_rad"})
+                        columns={**columns, "torque": "torque_Nm", "measured": "deflection_rad",
+                                 "velocity": "d(deflection_rad)/dt"})
     raise LoopInputError(f"predict = '{predict}': use 'torque' (from deflection) or 'deflection' (from torque)")
 
 

@@ -178,13 +178,13 @@ class LoopData:
             d = self.signals.get("deflection")
             deflection = float(np.max(np.abs(d))) if d is not None and np.ptp(d) > 0 else 1.0
             torque = float(np.ptp(self.measured)) or 1.0
-        v = self.signals.get("motor_velocity" if self.direction == "compliance" and "effort" in self.signals
-                             else "velocity")
+        v = self.signals.get("motor_velocity" if "motor_velocity" in self.signals else "velocity")
         velocity = float(np.quantile(np.abs(v), 0.9)) if v is not None else 1.0
         t = self.signals.get("temperature")
         return Scales(deflection_rad=deflection, torque_Nm=torque, velocity_rad_per_s=velocity or 1.0,
                       duration_s=float(np.ptp(self.time)), dt_s=self.dt, k_Nm_per_rad=k,
-                      measured_span=float(np.ptp(self.measured)) or 1.0,
+                      measured_span=float(np.ptp(self.signals["deflection"] if self.sensor_on == "deflection"
+                                                 else self.measured)) or 1.0,
                       temperature_C=float(t[0]) if t is not None else 23.0, generic=self.spring is None)
 
 

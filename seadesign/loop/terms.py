@@ -14,8 +14,12 @@ effect's, with the effect's names and units. `PLACES` says where an effect acts:
   temperature softening (factors; thermal in the compliance direction marched in time);
 - `load` (stiffness direction): friction against `velocity`, gravity against `angle`.
 
-Stateful effects read the Savitzky-Golay smoothed deflection (`LoopData.smooth`), so sensor noise
-does not act as many tiny reversals; the fitter's filters run at the median sample interval.
+A spring model (bench, robot) reads its input (deflection; torque or effort, with the friction taken off
+it) through the zero-phase Savitzky-Golay smoother (`LoopData.smooth`, ~0.1 s): the input's noise would
+otherwise let any filter-like effect (a fractional-sample shift, a fast relaxation, a rate term) lower
+the error by averaging that noise and be named for it. On a generic table stateful effects read the
+smoothed deflection (noise would act as many tiny reversals) and a delay shifts the smoothed prediction
+and adds the change. The fitter's filters run at the median sample interval.
 """
 
 from __future__ import annotations
@@ -23,9 +27,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import shift
 
 from seadesign.effects import LIBRARY, Effect
-from seadesign.effects.spring import dahl, leaky_sum, sls_deflection, softening_from_compliance, solve_cubic
+from seadesign.effects.spring import dahl, sls_deflection, softening_marched, solve_cubic
 from seadesign.loop.table import LoopData, smooth
 
 PLACES: dict[str, str] = {
@@ -40,9 +45,17 @@ ORDER = ("effort_lag", "friction", "dead_band", "stiffness_scale", "cubic_stiffe
          "sensor_drift")
 #: effects the loop can trace as candidates (library keys); the spring itself is declared, not traced
 CANDIDATES = tuple(k for k in ORDER if k != "stiffness_scale")
-#: effects whose value at a sample needs the whole record (history or neighbours); a model without them is
-#: evaluated on the fitted rows alone (`LoopData.subset`)
+#: effects whose value at a sample needs the whole record (history or neighbours: the smoothed friction, the
+#: sensor effects undone before smoothing); a model without them is evaluated on the fitted rows alone
 WHOLE_RECORD = frozenset({"hysteresis", "viscoelastic", "thermal_softening", "sensor_delay"})
+
+
+def whole_record(terms: list[Term], data: LoopData) -> bool:
+    """Whether `terms` on `data` need the whole record (else the fitted rows alone will do)."""
+    keys = {t.key for t in terms}
+    return bool(keys & WHOLE_RECORD) or (data.direction == "compliance" and "friction" in keys) or \
+        (data.sensor_on == "deflection" and data.spring is not None and bool(keys & {k for k, v in PLACES.items()
+                                                                                      if v == "sensor"}))
 
 
 @dataclass(frozen=True)
@@ -60,8 +73,9 @@ class Term:
 
 
 def place(term: Term, data: LoopData) -> str:
-    """Where `term` acts on `data`: friction acts on the effort when the data has one (gear friction)."""
-    if term.key == "friction" and data.direction == "compliance" and "effort" in data.signals:
+    """Where `term` acts on `data`: in the compliance direction friction is taken off the torque input (gear
+    friction off the effort, against the motor velocity; a bench's friction against the deflection rate)."""
+    if term.key == "friction" and data.direction == "compliance":
         return "effort"
     return PLACES[term.key]
 
@@ -71,7 +85,7 @@ def applicable(key: str, data: LoopData) -> bool:
     s, comp = data.signals, data.direction == "compliance"
     need = {
         "effort_lag": comp and "effort" in s,
-        "friction": ("motor_velocity" in s and "effort" in s) if comp else "velocity" in s,
+        "friction": ("motor_velocity" in s or "velocity" in s) if comp else "velocity" in s,
         "gravity": not comp and "angle" in s,
         "temperature_softening": "temperature" in s,
         "stiffness_scale": data.spring is not None or np.ptp(data.predicted) > 0,
@@ -97,8 +111,18 @@ def predict(data: LoopData, terms: list[Term], values: dict[str, dict[str, float
         y = _torque(data, at, values)
     if data.sensor_on == "measured":
         for t in at["sensor"]:
-            y = t.effect.evaluate({"hall": y, "time": data.time}, values[t.name])
+            y = _delayed(data, y, values[t.name]["delay_s"]) if t.key == "sensor_delay" else \
+                t.effect.evaluate({"hall": y, "time": data.time}, values[t.name])
     return y
+
+
+def _delayed(data: LoopData, y: np.ndarray, delay_s: float) -> np.ndarray:
+    """y(t - delay_s): the smoothed y shifted plus the raw y's own noise, so a fraction of a sample cannot
+    average the noise away; a negative delay advances. The shift is a cubic-spline interpolation at the median
+    sample interval (`scipy.ndimage.shift`): smooth in the delay, where linear interpolation has a kink at every
+    whole sample that stops a least-squares search there."""
+    ys = smooth(y, data.time)
+    return y + shift(ys, delay_s / data.dt, order=3, mode="nearest") - ys
 
 
 def _sensor_inverse(data: LoopData, terms: list[Term], values, d: np.ndarray) -> np.ndarray:
@@ -106,7 +130,7 @@ def _sensor_inverse(data: LoopData, terms: list[Term], values, d: np.ndarray) ->
     for t in reversed(terms):
         p = values[t.name]
         if t.key == "sensor_delay":
-            d = np.interp(data.time + p["delay_s"], data.time, d)
+            d = _delayed(data, d, -p["delay_s"])
         else:  # additive: offset, step, drift with the opposite sign
             d = t.effect.evaluate({"hall": d, "time": data.time}, {k: (-v if k != "time_s" else v) for k, v in p.items()})
     return d
@@ -122,17 +146,19 @@ def _path(data: LoopData, d: np.ndarray) -> np.ndarray:
 def _torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
     """Stiffness direction: deflection -> (sensor undone) -> dead-band -> spring law -> + loads."""
     s = data.signals
-    d0 = s.get("deflection")
+    spring = data.spring is not None  # a spring's deflection input is read through the smoother
+    d0 = data.smooth("deflection") if spring else s.get("deflection")
     path0 = data.predicted if data.predicted is not None else _path(data, d0)
     d, path = d0, path0
     if data.sensor_on == "deflection" and at["sensor"]:
-        d = _sensor_inverse(data, at["sensor"], values, d0)
+        d = _sensor_inverse(data, at["sensor"], values, s["deflection"])
+        d = smooth(d, data.time) if spring else d
         path = path0 + _path(data, d) - _path(data, d0)
     for t in at["deflection"]:
         banded = t.effect.evaluate({"deflection": d}, values[t.name])
         path, d = path + _path(data, banded) - _path(data, d), banded
     stateful = {"hysteresis", "viscoelastic", "thermal_softening"} & {t.key for t in at["spring"]}
-    ds = None if not stateful else smooth(d, data.time) if d is not d0 else data.smooth("deflection")
+    ds = None if not stateful else d if spring else smooth(d, data.time) if d is not d0 else data.smooth("deflection")
     tau, factor = path, 1.0
     for t in at["spring"]:
         p = values[t.name]
@@ -142,8 +168,9 @@ def _torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
             tau = tau + p["k3_Nm_per_rad3"] * d ** 3
         elif t.key == "hysteresis":
             tau = tau + dahl(ds, p["torque_Nm"], p["stiffness_Nm_per_rad"])
-        elif t.key == "viscoelastic":
-            tau = tau + t.effect.evaluate({"deflection": ds, "time": data.time, "torque": np.zeros_like(ds)}, p)
+        elif t.key == "viscoelastic":  # k2 (d - relaxed): the relaxed state from the smoothed deflection
+            arm = t.effect.evaluate({"deflection": ds, "time": data.time, "torque": np.zeros_like(ds)}, p)
+            tau = tau + arm + p["maxwell_stiffness_Nm_per_rad"] * (d - ds)
         elif t.key == "thermal_softening":
             factor = factor * _thermal_factor(data, p, lambda: path * np.diff(ds, prepend=ds[0]))
         else:  # temperature_softening
@@ -154,26 +181,29 @@ def _torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
     return y
 
 
-def _thermal_factor(data: LoopData, p: dict[str, float], power) -> np.ndarray:
+def _thermal_factor(data: LoopData, p: dict[str, float], work) -> np.ndarray:
+    """Thermal softening's stiffness factor: from a measured `energy` signal, else marched from `work()`."""
     if "energy" in data.signals:
         e = data.signals["energy"]
         return np.maximum(1.0 - p["softening_per_J"] * (e - e[0]), 0.05)
-    heat = leaky_sum(np.abs(power()), data.dt, p["cooling_time_s"])
-    return np.maximum(1.0 - p["softening_per_J"] * heat, 0.05)
+    return softening_marched(np.abs(work()), data.dt, p["softening_per_J"], p["cooling_time_s"],
+                             data.direction == "compliance")
 
 
-def spring_torque(data: LoopData, at: dict[str, list[Term]], values, smoothed: bool = False) -> np.ndarray:
+def spring_torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
     """Compliance direction: the spring torque from the torque or effort signal, the effort's lag and gear
-    friction undone; `smoothed`: from the smoothed signals (for a dead-band's side and the stateful effects)."""
+    friction undone, through the zero-phase smoother (module docstring)."""
     role = "torque" if "torque" in data.signals else "effort"
-    tau = data.smooth(role) if smoothed else data.input_torque
+    tau = data.smooth(role)
     for t in at["effort"]:
         p = values[t.name]
         if t.key == "effort_lag":
             tau = tau + p["time_constant_s"] * data.rate("effort")
-        else:  # gear friction on the motor side, in the effort
-            e, v = t.effect, data.smooth("motor_velocity") if smoothed else data.signals["motor_velocity"]
-            tau = tau - e.evaluate({e.signal("velocity"): v, e.signal("load_torque"): np.zeros(data.n)}, p)
+        else:  # friction on the motor side (gear friction in the effort), or against a bench's deflection rate
+            e = t.effect
+            v = data.signals["motor_velocity" if "motor_velocity" in data.signals else "velocity"]
+            tau = tau - smooth(e.evaluate({e.signal("velocity"): v, e.signal("load_torque"): np.zeros(data.n)}, p),
+                               data.time)
     return tau
 
 
@@ -184,11 +214,7 @@ def _deflection(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray
     scale = values[spring[0].name]["scale"] if spring else 1.0
     k = data.gain * scale
     curve = hasattr(data.spring, "curve")
-    x = data.spring.rotation(tau, scale) if curve else tau / k
-    xs = x
-    if any(t.key != "stiffness_scale" for t in at["spring"]) or at["deflection"]:
-        tau_s = spring_torque(data, at, values, smoothed=True)
-        xs = data.spring.rotation(tau_s, scale) if curve else tau_s / k
+    xs = x = data.spring.rotation(tau, scale) if curve else tau / k
     for t in at["spring"]:
         p = values[t.name]
         if t.key == "cubic_stiffening":  # k d + k3 d^3 = k x
@@ -196,10 +222,9 @@ def _deflection(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray
         elif t.key == "hysteresis":
             x = x - dahl(xs, p["torque_Nm"], p["stiffness_Nm_per_rad"]) / k
         elif t.key == "viscoelastic":
-            x = sls_deflection(x, data.dt, p["maxwell_stiffness_Nm_per_rad"] / k, p["relaxation_time_s"])
+            x = x + sls_deflection(xs, data.dt, p["maxwell_stiffness_Nm_per_rad"] / k, p["relaxation_time_s"]) - xs
         elif t.key == "thermal_softening":
-            x = x / (softening_from_compliance(xs, tau_s, data.dt, p["softening_per_J"], p["cooling_time_s"])
-                     if "energy" not in data.signals else _thermal_factor(data, p, None))
+            x = x / _thermal_factor(data, p, lambda: tau * np.diff(xs, prepend=xs[0]))
         elif t.key == "temperature_softening":
             x = x / t.effect.evaluate({"temperature": data.signals["temperature"], "torque": np.ones(data.n)}, p)
     for t in at["deflection"]:  # the free travel, its side from the smoothed deflection
