@@ -23,11 +23,14 @@ def _euler_lag(x: np.ndarray, dt: float, tau: float, sub: int = 20) -> np.ndarra
     return out
 
 
-def _dahl(d: np.ndarray, torque: float, stiffness: float, sub: int = 50) -> np.ndarray:
-    """dz/dd = sigma (1 - z sign(dd) / tau_h) by explicit Euler in `sub` substeps of each sample's deflection step."""
+def _dahl(d: np.ndarray, torque: float, stiffness: float) -> np.ndarray:
+    """dz/dd = sigma (1 - z sign(dd) / tau_h) by explicit Euler, each sample's deflection step cut into substeps
+    of at most a fiftieth of tau_h / sigma (at least 50)."""
     z, out = 0.0, np.empty_like(d)
     for i in range(d.size):
-        dd = (d[i] - d[i - 1]) / sub if i else 0.0
+        step = d[i] - d[i - 1] if i else 0.0
+        sub = max(50, int(np.ceil(50 * stiffness * abs(step) / torque)))
+        dd = step / sub
         for _ in range(sub if i else 0):
             z += stiffness * (1 - z * np.sign(dd) / torque) * dd
         out[i] = z
@@ -35,9 +38,10 @@ def _dahl(d: np.ndarray, torque: float, stiffness: float, sub: int = 50) -> np.n
 
 
 def bench(effects: dict[str, dict[str, float]], seed: int = 1, duration_s: float = 60.0, rate_hz: float = 100.0,
-          frequency_hz: float = 0.1, torque_amplitude_Nm: float = 4.8, k: float = K) -> pd.DataFrame:
+          frequency_hz: float = 0.1, torque_amplitude_Nm: float = 4.8, k: float = K, harmonic: bool = True) -> pd.DataFrame:
     """A torque-deflection bench test: the deflection driven by two sines (`frequency_hz` and 3.7 times it, 70 / 30 %
-    of the amplitude), so that a phase lead that grows with frequency (viscoelasticity) differs from a delay;
+    of the amplitude; one sine without `harmonic`), so that a phase lead that grows with frequency
+    (viscoelasticity) differs from a delay;
     the torque sensor reads the spring torque (+ bench friction); the deflection reading carries the sensor
     effects. Bench format columns."""
     rng = np.random.default_rng(seed)
@@ -45,10 +49,12 @@ def bench(effects: dict[str, dict[str, float]], seed: int = 1, duration_s: float
     w, a = 2 * np.pi * frequency_hz, torque_amplitude_Nm / k
     e = effects
 
-    def drive(time):
-        return a * (0.7 * np.sin(w * time) + 0.3 * np.sin(3.7 * w * time + 1.0))
+    h = 0.3 if harmonic else 0.0
 
-    d, rate = drive(t), a * w * (0.7 * np.cos(w * t) + 1.11 * np.cos(3.7 * w * t + 1.0))
+    def drive(time):
+        return a * ((1 - h) * np.sin(w * time) + h * np.sin(3.7 * w * time + 1.0))
+
+    d, rate = drive(t), a * w * ((1 - h) * np.cos(w * t) + 3.7 * h * np.cos(3.7 * w * t + 1.0))
     b = e.get("dead_band", {}).get("width_rad", 0.0)
     ds = np.sign(d) * np.maximum(np.abs(d) - b / 2, 0.0)
     tau = k * e.get("stiffness_scale", {}).get("scale", 1.0) * ds + e.get("cubic_stiffening", {}).get("k3_Nm_per_rad3", 0.0) * ds ** 3
@@ -66,7 +72,7 @@ def bench(effects: dict[str, dict[str, float]], seed: int = 1, duration_s: float
         tau = tau * f
     out = {"time_s": t}
     if "temperature_softening" in e:
-        temp = np.linspace(25.0, 45.0, t.size)
+        temp = 25.0 + 20.0 * np.sin(np.pi * t / t[-1])  # heated and cooled from outside: not the spring's own work
         tau = tau * (1 - e["temperature_softening"]["softening_per_K"] * (temp - temp[0]))
         out["temperature_C"] = temp
     if "friction" in e:
@@ -123,6 +129,10 @@ def robot(effects: dict[str, dict[str, float]], seed: int = 1, duration_s: float
         spring_defl = tau / (k_true * (1 - p["softening_per_J"] * h))
     else:
         spring_defl = tau / k_true
+    if "cubic_stiffening" in e:  # k d + k3 d^3 = tau, by Newton from the linear deflection
+        k3 = e["cubic_stiffening"]["k3_Nm_per_rad3"]
+        for _ in range(30):
+            spring_defl = spring_defl - (k_true * spring_defl + k3 * spring_defl ** 3 - tau) / (k_true + 3 * k3 * spring_defl ** 2)
     b = e.get("dead_band", {}).get("width_rad", 0.0)
     motor = q + spring_defl + np.sign(tau) * b / 2
     vm = np.gradient(motor, t)

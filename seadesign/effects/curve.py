@@ -98,13 +98,13 @@ class TorqueCurve:
             raise CurveRangeError(f"rotation {float(a.max()):.4g} rad is past the spring's torque curve: {self._end()}")
         return np.sign(th) * self._pchip()(np.minimum(a, self.end_rotation_rad))
 
-    def rotation(self, torque_Nm: np.ndarray, iterations: int = 40) -> np.ndarray:
+    def rotation(self, torque_Nm: np.ndarray, iterations: int = 60, clamp: bool = False) -> np.ndarray:
         """theta(T) (rad), the exact inverse of `torque`; past the end torque: the end rotation with a hard
-        stop, else CurveRangeError."""
+        stop or `clamp` (a fitter's trial values), else CurveRangeError."""
         tq = np.asarray(torque_Nm, dtype=float)
         a = np.abs(tq)
         past = a > self.end_torque_Nm
-        if past.any() and not self.hard_stop:
+        if past.any() and not (self.hard_stop or clamp):
             raise CurveRangeError(f"torque {float(a.max()):.4g} Nm is past the spring's torque curve: {self._end()}")
         a = np.minimum(a, self.end_torque_Nm)
         nodes, p = np.asarray(self.torque_Nm), self._pchip()
@@ -114,6 +114,8 @@ class TorqueCurve:
         u = hi * (a - nodes[i]) / (nodes[i + 1] - nodes[i])  # start from the chord
         for _ in range(iterations):  # Newton kept inside a shrinking bracket (bisection when it would leave)
             f = ((c[0] * u + c[1]) * u + c[2]) * u + c[3] - a
+            if np.all(np.abs(f) <= 1e-14 * self.end_torque_Nm):
+                break
             lo, hi = np.where(f < 0, u, lo), np.where(f > 0, u, hi)
             df = (3 * c[0] * u + 2 * c[1]) * u + c[2]
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -146,9 +148,10 @@ class SpringCurve(Effect):
     def _map(self, x, p, rng):
         return x["torque"] + p["scale"] * self.curve.torque(x["deflection"])
 
-    def rotation(self, torque_Nm: np.ndarray, scale: float | None = None) -> np.ndarray:
-        """Deflection (rad) at which the scaled curve carries `torque_Nm`."""
-        return self.curve.rotation(np.asarray(torque_Nm) / (self.values["scale"] if scale is None else scale))
+    def rotation(self, torque_Nm: np.ndarray, scale: float | None = None, clamp: bool = False) -> np.ndarray:
+        """Deflection (rad) at which the scaled curve carries `torque_Nm` (`clamp`: see `TorqueCurve.rotation`)."""
+        return self.curve.rotation(np.asarray(torque_Nm) / (self.values["scale"] if scale is None else scale),
+                                   clamp=clamp)
 
     def search(self, s: Scales) -> Search:
         lowest = max(0.01, s.torque_Nm / self.curve.end_torque_Nm) if not self.curve.hard_stop else 0.01

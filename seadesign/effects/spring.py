@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 from scipy.signal import lfilter, lfilter_zi
+from scipy.special import erf
 
 from seadesign.effects.base import Effect, Param, Scales, Search, lowpass, rows, time_steps
 
@@ -36,10 +37,12 @@ class DeadBand(Effect):
         return np.sign(d) * np.maximum(np.abs(d) - 0.5 * p["width_rad"], 0.0)
 
     @staticmethod
-    def free_travel(spring_deflection: np.ndarray, width_rad: float) -> np.ndarray:
+    def free_travel(spring_deflection: np.ndarray, width_rad: float, noise_rad: float = 0.0) -> np.ndarray:
         """Deflection (rad) across the zone when the spring carries `spring_deflection`: the inverse,
-        sign(d) (|d| + b/2), for a deflection known from the torque."""
-        return spring_deflection + np.sign(spring_deflection) * 0.5 * width_rad
+        d + sign(d) b/2, for a deflection known from the torque. Known only to `noise_rad` (1 sigma), the side
+        is uncertain near zero and the expected travel is d + erf(d / (sqrt(2) noise)) b/2."""
+        side = np.sign(spring_deflection) if noise_rad <= 0 else erf(spring_deflection / (math.sqrt(2) * noise_rad))
+        return spring_deflection + side * 0.5 * width_rad
 
     def search(self, s: Scales) -> Search:
         hi = min(0.5, 2.0 * s.deflection_rad)
@@ -228,9 +231,10 @@ def leaky_sum(h: np.ndarray, dt: float, tau: float) -> np.ndarray:
 
 
 def softening_marched(work: np.ndarray, dt: float, c: float, tc: float, compliance: bool,
-                      chunk: int = 25) -> np.ndarray:
-    """Stiffness factor f per sample of `ThermalSoftening`, marched in chunks of `chunk` samples at a uniform
-    sample interval dt (s), f constant within a chunk and solved implicitly there (closed form).
+                      chunk: int | None = None) -> np.ndarray:
+    """Stiffness factor f per sample of `ThermalSoftening`, marched in chunks of `chunk` samples (default:
+    25, or 1/200 of the record if longer) at a uniform sample interval dt (s), f constant within a chunk and
+    solved implicitly there (closed form).
 
     `work` per sample: |torque dd| with the torque of the unsoftened spring (stiffness direction, where the
     deflection d is known: the spring takes f times that) or |torque dx| with x = torque / k (compliance
@@ -240,6 +244,7 @@ def softening_marched(work: np.ndarray, dt: float, c: float, tc: float, complian
     chunking keeps it stable where a whole-record fixed point diverges (past a third of softening).
     """
     a = math.exp(-dt / tc)
+    chunk = chunk or max(25, work.size // 200)
     filled = leaky_sum(work, dt, tc)
     ends = np.append(np.arange(chunk - 1, work.size - 1, chunk), work.size - 1)
     per_chunk = np.empty(ends.size)

@@ -6,12 +6,12 @@ what was declared.
 2. The declared model refitted (`base`): every declared parameter free, started at its declared
    value, and the stiffness scale (the declared k is always refitted).
 3. Forward selection: each undeclared effect of the library that applies is fitted together with
-   the current model; it is accepted when it cuts the held-out RMSE by at least `min_gain` (5 %)
+   the current model (screened first with the declared effects but the stiffness scale held; the
+   `screen` best, and any the screen accepts, refitted with everything free); it is accepted when it cuts the held-out RMSE by at least `min_gain` (5 %)
    and lowers the training BIC by at least `min_bic_drop` (10, "very strong" evidence). The winner
    is the accepted one with the lowest held-out RMSE, except that a fit pinned at a search bound
    wins only when no accepted fit lies inside its bounds. When the runner-up is as good (held-out
-   RMSE within `ambiguity`, 3 %, BIC not worse by `min_bic_drop`) and the two together do not beat the
-   winner by `min_gain`, the data
+   RMSE within `ambiguity`, 3 %) and the two together do not beat the winner by `min_gain`, the data
    cannot tell them apart: the step is reported as an ambiguity with both fits, not a single name.
    A sensor step is proposed at the instant change-point detection finds in the current residual.
 4. Declared effects are tested: one that can be dropped without raising the held-out RMSE by
@@ -148,7 +148,7 @@ def _term(key: str, data: LoopData, current: Fit) -> Term | None:
     if key != "sensor_step":
         return Term(key, LIBRARY[key]())
     taken = [current.values[t.name]["time_s"] for t in current.terms if t.key == "sensor_step"]
-    index = best_split(data.measured - current.prediction, min_size=max(10, data.n // 50),
+    index = best_split(data.measured - current.prediction, min_size=max(10, data.n // 10),  # ends: an offset
                        exclude=[int(np.searchsorted(data.time - data.time[0], s)) for s in taken])
     if index is None:
         return None
@@ -166,7 +166,7 @@ def _fit(data: LoopData, terms: list[Term], held: np.ndarray, warm: dict | None 
 
 
 def explain(data: LoopData, declared: Sequence[Effect] = (), *, exclude: Sequence[str] = (), min_gain: float = 0.05,
-            min_bic_drop: float = 10.0, ambiguity: float = 0.03, max_steps: int = 4, n_blocks: int = 10,
+            min_bic_drop: float = 10.0, ambiguity: float = 0.03, max_steps: int = 4, screen: int = 3, n_blocks: int = 10,
             held_out_blocks: tuple[int, ...] = (2, 7), candidates: Sequence[str] | None = None) -> Explanation:
     """Run the loop on `data` with the `declared` effects (library effects with their declared values);
     `exclude`: library keys not traced (effects a generic table's prediction already holds)."""
@@ -187,22 +187,13 @@ def explain(data: LoopData, declared: Sequence[Effect] = (), *, exclude: Sequenc
         return f.errors["held_out"]["rmse"] <= (1 - min_gain) * ref.errors["held_out"]["rmse"] and f.bic <= ref.bic - min_bic_drop
 
     for _ in range(max_steps):
-        trace = []
-        for key in pool:
-            if key in {t.key for t in current.terms} and key != "sensor_step":
-                continue
-            term = _term(key, data, current)
-            if term is None:
-                continue
-            f = _fit(data, current.terms + [term], held, current.values)
-            trace.append(TraceEntry(term.name, f, f.errors["held_out"]["rmse"], f.bic, f.aic, gate(f, current),
-                                    _pinned(f, term.name)))
+        trace = _trace(data, held, current, pool, gate, screen)
         trace.sort(key=lambda t: t.held_out_rmse)
         winners = sorted((t for t in trace if t.accepted), key=lambda t: t.at_bound)  # stable: RMSE order kept
         if not winners:
             break
         best = winners[0]
-        alt = _alternative(data, held, best, winners[1:], ambiguity, min_gain, min_bic_drop)
+        alt = _alternative(data, held, best, winners[1:], ambiguity, min_gain)
         steps.append(Step(best.effect, current, best.fit, trace, alt))
         current = best.fit
     checks, current = _check_declared(data, held, current, decl, gate)
@@ -212,21 +203,43 @@ def explain(data: LoopData, declared: Sequence[Effect] = (), *, exclude: Sequenc
         tests_before=residual_tests(data.measured - plain.prediction, data.time, sig),
         tests_after=residual_tests(data.measured - current.prediction, data.time, sig),
         settings={"min_gain": min_gain, "min_bic_drop": min_bic_drop, "ambiguity": ambiguity, "max_steps": max_steps,
-                  "n_blocks": n_blocks, "held_out_blocks": list(held_out_blocks),
+                  "screen": screen, "n_blocks": n_blocks, "held_out_blocks": list(held_out_blocks),
                   "declared": [t.name for t in decl], "excluded": list(exclude), "candidates": pool},
     )
 
 
-def _alternative(data, held, best: TraceEntry, others: list[TraceEntry], ambiguity: float, min_gain: float,
-                 min_bic_drop: float) -> TraceEntry | None:
-    """The runner-up when the data cannot tell it from the winner: within `ambiguity` in held-out RMSE and
-    `min_bic_drop` in BIC, inside its bounds, and not adding `min_gain` when fitted together with the winner."""
+def _trace(data: LoopData, held: np.ndarray, current: Fit, pool: list[str], gate, screen: int) -> list[TraceEntry]:
+    """Every candidate fitted with the current model: first screened (the declared effects but the stiffness
+    scale held), then the `screen` best and every one the screen already accepts refitted with all free."""
+    held_values = {t.name: current.values[t.name] for t in current.terms if t.declared and t.key != SCALE}
+    screened = []
+    for key in pool:
+        if key in {t.key for t in current.terms} and key != "sensor_step":
+            continue
+        term = _term(key, data, current)
+        if term is not None:
+            f = _fit(data, current.terms + [term], held, current.values, fixed=held_values)
+            screened.append((term, f))
+    screened.sort(key=lambda tf: tf[1].errors["held_out"]["rmse"])
+    trace = []
+    for i, (term, f) in enumerate(screened):
+        if i < screen or gate(f, current):
+            f = _fit(data, current.terms + [term], held, {**current.values, term.name: f.values[term.name]})
+        trace.append(TraceEntry(term.name, f, f.errors["held_out"]["rmse"], f.bic, f.aic, gate(f, current),
+                                _pinned(f, term.name)))
+    return trace
+
+
+def _alternative(data, held, best: TraceEntry, others: list[TraceEntry], ambiguity: float,
+                 min_gain: float) -> TraceEntry | None:
+    """The runner-up when the data cannot tell it from the winner: within `ambiguity` in held-out RMSE, inside
+    its bounds, and not adding `min_gain` when fitted together with the winner."""
     inside = [t for t in others if not t.at_bound]
     if not inside or best.at_bound:
         return None
     alt = inside[0]
-    if alt.held_out_rmse > (1 + ambiguity) * best.held_out_rmse or alt.bic >= best.bic + min_bic_drop:
-        return None  # told apart: by held-out error, or by BIC (the winner as good with fewer parameters)
+    if alt.held_out_rmse > (1 + ambiguity) * best.held_out_rmse:
+        return None
     both = _fit(data, best.fit.terms + [alt.fit.term(alt.effect)], held, {**best.fit.values, **alt.fit.values})
     return alt if both.errors["held_out"]["rmse"] > (1 - min_gain) * best.held_out_rmse else None
 

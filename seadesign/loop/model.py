@@ -169,7 +169,8 @@ class EffectModel:
         ssr = float(np.sum((data.measured[train] - pred[train]) ** 2))
         sigma = np.zeros(len(names))
         if best is not None:
-            jac = best.jac * np.where(logs[free], 1.0 / x_best[free], 1.0)  # d/dx = d/du / x for log parameters
+            with np.errstate(over="ignore", divide="ignore"):
+                jac = best.jac * np.where(logs[free], 1.0 / x_best[free], 1.0)  # d/dx = d/du / x for log parameters
             try:
                 cov = np.linalg.pinv(jac.T @ jac * (n / rows.size)) * ssr / max(n - int(free.sum()), 1)
                 sigma[free] = np.sqrt(np.clip(np.diag(cov), 0, None))

@@ -17,11 +17,13 @@ Signals use the one vocabulary of the effect library (`seadesign.effects.SIGNALS
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy.signal import savgol_filter
+from scipy.ndimage import convolve1d
+from scipy.signal import savgol_coeffs, savgol_filter
 
 from seadesign.effects import SIGNALS, Effect, Scales
 from seadesign.errors import DataError
@@ -98,6 +100,11 @@ class LoopData:
             raise LoopInputError("a table needs a predicted column, or a spring and a deflection signal")
         if self.gain is None:
             self.gain = self._gain()
+        if hasattr(self.spring, "curve"):  # the data must lie on the curve (raises past its end, no hard stop)
+            if self.direction == "compliance":
+                self.spring.rotation(self.smooth("torque" if "torque" in self.signals else "effort"))
+            else:
+                self.spring.apply({"deflection": self.signals["deflection"]})
 
     def _gain(self) -> float:
         """Slope of the spring path against the deflection (measured unit per deflection unit)."""
@@ -116,6 +123,14 @@ class LoopData:
             self.__dict__[key] = smooth(self.signals[role], self.time)
         return self.__dict__[key]
 
+    def noise(self, role: str) -> float:
+        """Noise (1 sigma, the signal's unit) left in `smooth(role)`: 0.51 x std(signal - smoothed), the share a
+        quadratic Savitzky-Golay smoother of 11 samples keeps of white noise (cached)."""
+        key = f"_noise_{role}"
+        if key not in self.__dict__:
+            self.__dict__[key] = 0.51 * float(np.std(self.signals[role] - self.smooth(role)))
+        return self.__dict__[key]
+
     def rate(self, role: str) -> np.ndarray:
         """Savitzky-Golay rate of signal `role` per second (cached)."""
         key = f"_rate_{role}"
@@ -129,6 +144,7 @@ class LoopData:
         for role in ("torque", "effort", "motor_velocity", "deflection"):
             if role in self.signals:
                 self.smooth(role)
+                self.noise(role)
         if "effort" in self.signals:
             self.rate("effort")
         self.scales()
@@ -221,11 +237,17 @@ def smooth_rate(x: np.ndarray, time: np.ndarray, window_s: float = 0.1) -> np.nd
     return np.gradient(x, time) if window >= x.size else savgol_filter(x, window, 2, deriv=1, delta=dt)
 
 
+@lru_cache(maxsize=16)
+def _savgol(window: int) -> np.ndarray:
+    return savgol_coeffs(window, 2)
+
+
 def smooth(x: np.ndarray, time: np.ndarray, window_s: float = 0.1) -> np.ndarray:
-    """x through a quadratic Savitzky-Golay smoother of ~`window_s` s (edges: nearest value; one
-    convolution, about 20x faster than the polynomial edge fit, which a fitter calls thousands of times)."""
+    """x through a quadratic Savitzky-Golay smoother of ~`window_s` s: one convolution with cached coefficients,
+    edges held at the nearest value (scipy's `savgol_filter(..., mode="nearest")`, which a fitter would
+    otherwise recompute the coefficients for thousands of times)."""
     window = _window(time, window_s)
-    return x if window >= x.size else savgol_filter(x, window, 2, mode="nearest")
+    return x if window >= x.size else convolve1d(np.asarray(x, dtype=float), _savgol(window), mode="nearest")
 
 
 def time_blocks(n: int, n_blocks: int = 10, held_out: tuple[int, ...] = (2, 7)) -> np.ndarray:

@@ -214,7 +214,8 @@ def _deflection(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray
     scale = values[spring[0].name]["scale"] if spring else 1.0
     k = data.gain * scale
     curve = hasattr(data.spring, "curve")
-    xs = x = data.spring.rotation(tau, scale) if curve else tau / k
+    # a fitter's trial may push the torque past the curve's end: held there (the data's range is checked up front)
+    xs = x = data.spring.rotation(tau, scale, clamp=True) if curve else tau / k
     for t in at["spring"]:
         p = values[t.name]
         if t.key == "cubic_stiffening":  # k d + k3 d^3 = k x
@@ -227,6 +228,7 @@ def _deflection(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray
             x = x / _thermal_factor(data, p, lambda: tau * np.diff(xs, prepend=xs[0]))
         elif t.key == "temperature_softening":
             x = x / t.effect.evaluate({"temperature": data.signals["temperature"], "torque": np.ones(data.n)}, p)
-    for t in at["deflection"]:  # the free travel, its side from the smoothed deflection
-        x = x + t.effect.free_travel(xs, values[t.name]["width_rad"]) - xs
+    for t in at["deflection"]:  # the free travel, its side as uncertain as the smoothed torque
+        noise = data.noise("torque" if "torque" in data.signals else "effort") / k
+        x = x + t.effect.free_travel(xs, values[t.name]["width_rad"], noise) - xs
     return x
