@@ -12,7 +12,7 @@ per case (the first by default, the others with the slow tests):
 | gear friction | Coulomb 0.2-0.5 Nm | |
 | sensor delay | 20-60 ms | |
 | sensor step | 0.03-0.15 rad at 20-80 % of the record | |
-| thermal softening | 0.012-0.016 /J, cooling 300 s | floor: about 25 % softening by the end of 120 s (0.010 /J) |
+| thermal softening | 0.012-0.016 /J, cooling 300 s (23-34 % softer at the end) | floor: about 10 % softening by the end |
 
 Plain model: exactly that effect is named (nothing for clean data), no ambiguity. Default declared chain
 (backlash 0.25 deg and gear friction 0.3 Nm): the undeclared cases name exactly their effect and report both
