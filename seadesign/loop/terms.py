@@ -105,8 +105,7 @@ def predict(data: LoopData, terms: list[Term], values: dict[str, dict[str, float
     terms = ordered(terms)
     at = {p: [t for t in terms if place(t, data) == p] for p in ("sensor", "effort", "deflection", "spring", "load")}
     if data.direction == "compliance":
-        y = data.base + data.sign * _deflection(data, at, values) if data.base is not None else \
-            data.sign * _deflection(data, at, values)
+        y = (0.0 if data.base is None else data.base) + data.sign * _deflection(data, at, values)
     else:
         y = _torque(data, at, values)
     if data.sensor_on == "measured":
