@@ -133,6 +133,8 @@ class Explanation:
                     f"(held-out RMSE {h0:.4g} -> {h1:.4g} {unit}); nothing is named.")
         if self.unsupported:
             text += f" Declared but unsupported by the data: {', '.join(self.unsupported)}."
+        if not self.final.converged:
+            text += " The final fit did not converge (evaluation limit): its numbers are not a result."
         s = self.tests_after["strongest"]
         if self.tests_after["white"]:
             text += " The residual passes the whiteness tests: no structure is left that the tests can see."
