@@ -53,7 +53,8 @@ def main() -> None:
     ap.add_argument("--kind", choices=["bench", "robot", "both"], default="both")
     args = ap.parse_args()
     print(f"machine: {platform.machine()} {platform.processor() or ''}, {os.cpu_count()} CPUs visible, "
-          f"python {platform.python_version()}; {args.duration_s:g} s at {args.rate_hz:g} Hz")
+          f"python {platform.python_version()}; {args.duration_s:g} s at {args.rate_hz:g} Hz; "
+          f"load reference (a 1500 x 1500 matrix product, same process): {reference():.3f} s")
     print(f"{'recording':<10} {'samples':>8} {'candidates':>10}  {'effects found':<32} {'held-out RMSE':<26} "
           f"{'wall time (s), goal < 30':>24}")
     for kind in (["bench", "robot"] if args.kind == "both" else [args.kind]):
@@ -66,6 +67,15 @@ def main() -> None:
         print(f"{kind:<10} {data.n:>8} {len(ex.settings['candidates']):>10}  {', '.join(ex.found) or 'none':<32} "
               f"{rmse:<26} {wall:>24.2f}")
     changepoints(int(args.duration_s * args.rate_hz))
+
+
+def reference() -> float:
+    """Wall time (s) of a fixed matrix product: how busy the machine is (the explain times scale with it)."""
+    import numpy as np
+    a = np.random.default_rng(0).normal(size=(1500, 1500))
+    t0 = time.perf_counter()
+    a @ a
+    return time.perf_counter() - t0
 
 
 def changepoints(n: int) -> None:

@@ -41,7 +41,10 @@ class DeadBand(Effect):
         """Deflection (rad) across the zone when the spring carries `spring_deflection`: the inverse,
         d + sign(d) b/2, for a deflection known from the torque. Known only to `noise_rad` (1 sigma), the side
         is uncertain near zero and the expected travel is d + erf(d / (sqrt(2) noise)) b/2."""
-        side = np.sign(spring_deflection) if noise_rad <= 0 else erf(spring_deflection / (math.sqrt(2) * noise_rad))
+        side = np.sign(spring_deflection)
+        if noise_rad > 0:  # erf only where it differs from the sign (within 6 sigma of zero)
+            near = np.abs(spring_deflection) < 6.0 * noise_rad
+            side[near] = erf(spring_deflection[near] / (math.sqrt(2) * noise_rad))
         return spring_deflection + side * 0.5 * width_rad
 
     def search(self, s: Scales) -> Search:
@@ -84,8 +87,13 @@ def solve_cubic(x: np.ndarray, r: float, iterations: int = 12) -> np.ndarray:
     points +-1/sqrt(-3 r), beyond which no deflection carries the torque."""
     d = np.array(x, dtype=float)
     turn = 1.0 / math.sqrt(-3.0 * r) if r < 0 else math.inf
+    tol = 1e-13 * (float(np.max(np.abs(d))) if d.size else 0.0)
     for _ in range(iterations):
-        d = d - (d + r * d ** 3 - x) / np.maximum(1.0 + 3.0 * r * d * d, 1e-3)
+        d2 = d * d
+        f = d * (1.0 + r * d2) - x
+        if not np.max(np.abs(f), initial=0.0) > tol:  # converged (a turning point's clip leaves a residual)
+            break
+        d = d - f / np.maximum(1.0 + 3.0 * r * d2, 1e-3)
         if r < 0:
             d = np.clip(d, -turn, turn)
     return d

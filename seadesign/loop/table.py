@@ -120,8 +120,13 @@ class LoopData:
         stateful effects, so sensor noise does not act as many tiny reversals."""
         key = f"_smooth_{role}"
         if key not in self.__dict__:
-            self.__dict__[key] = smooth(self.signals[role], self.time)
+            self.__dict__[key] = self.smoothed(self.signals[role])
         return self.__dict__[key]
+
+    def smoothed(self, x: np.ndarray) -> np.ndarray:
+        """Any array over this record's samples through the same smoother (`smooth`, window from `dt`)."""
+        window = max(5, int(round(0.1 / self.dt)) | 1)
+        return x if window >= x.size else convolve1d(np.asarray(x, dtype=float), _savgol(window), mode="nearest")
 
     def noise(self, role: str) -> float:
         """Noise (1 sigma, the signal's unit) left in `smooth(role)`: 0.51 x std(signal - smoothed), the share a

@@ -31,7 +31,7 @@ from scipy.ndimage import shift
 
 from seadesign.effects import LIBRARY, Effect
 from seadesign.effects.spring import dahl, sls_deflection, softening_marched, solve_cubic
-from seadesign.loop.table import LoopData, smooth
+from seadesign.loop.table import LoopData
 
 PLACES: dict[str, str] = {
     "sensor_delay": "sensor", "sensor_offset": "sensor", "sensor_step": "sensor", "sensor_drift": "sensor",
@@ -120,7 +120,7 @@ def _delayed(data: LoopData, y: np.ndarray, delay_s: float) -> np.ndarray:
     average the noise away; a negative delay advances. The shift is a cubic-spline interpolation at the median
     sample interval (`scipy.ndimage.shift`): smooth in the delay, where linear interpolation has a kink at every
     whole sample that stops a least-squares search there."""
-    ys = smooth(y, data.time)
+    ys = data.smoothed(y)
     return y + shift(ys, delay_s / data.dt, order=3, mode="nearest") - ys
 
 
@@ -151,13 +151,13 @@ def _torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
     d, path = d0, path0
     if data.sensor_on == "deflection" and at["sensor"]:
         d = _sensor_inverse(data, at["sensor"], values, s["deflection"])
-        d = smooth(d, data.time) if spring else d
+        d = data.smoothed(d) if spring else d
         path = path0 + _path(data, d) - _path(data, d0)
     for t in at["deflection"]:
         banded = t.effect.evaluate({"deflection": d}, values[t.name])
         path, d = path + _path(data, banded) - _path(data, d), banded
     stateful = {"hysteresis", "viscoelastic", "thermal_softening"} & {t.key for t in at["spring"]}
-    ds = None if not stateful else d if spring else smooth(d, data.time) if d is not d0 else data.smooth("deflection")
+    ds = None if not stateful else d if spring else data.smoothed(d) if d is not d0 else data.smooth("deflection")
     tau, factor = path, 1.0
     for t in at["spring"]:
         p = values[t.name]
@@ -201,8 +201,7 @@ def spring_torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarr
         else:  # friction on the motor side (gear friction in the effort), or against a bench's deflection rate
             e = t.effect
             v = data.signals["motor_velocity" if "motor_velocity" in data.signals else "velocity"]
-            tau = tau - smooth(e.evaluate({e.signal("velocity"): v, e.signal("load_torque"): np.zeros(data.n)}, p),
-                               data.time)
+            tau = tau - data.smoothed(e.evaluate({e.signal("velocity"): v, e.signal("load_torque"): np.zeros(data.n)}, p))
     return tau
 
 
