@@ -9,7 +9,6 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from conftest import shared_path
 from seadesign.cli import main
 from seadesign.data import write_bench
 from seadesign.loop.thesis import K_FEA_NM_PER_RAD, K_MEASURED_NM_PER_RAD
