@@ -1,9 +1,8 @@
 """The spring as a measured or computed torque-rotation curve (large-deflection FEA) instead of k.
 
-spring.json may carry `torque_curve`: `rotation_rad` and `torque_Nm` (monotone from (0, 0),
-positive rotation only; the spring is symmetric, T(-theta) = -T(theta)), the `source`, why the
-computation stopped (`stop_reason`), where (`end_rotation_rad`, `end_torque_Nm`) and whether the
-end is a `hard_stop`. `TorqueCurve` reads and checks it; `SpringCurve` is the effect.
+spring.json (schema 2) may carry `torque_curve`: `rotation_rad` and `torque_Nm` (monotone from
+(0, 0), positive rotation only; the spring is symmetric, T(-theta) = -T(theta)), the `source`, why the
+computation stopped (`stop_reason`) and whether the end (the last point) is a `hard_stop`. `TorqueCurve` reads and checks it; `SpringCurve` is the effect.
 
 Interpolation: T(theta) is the monotone piecewise-cubic Hermite interpolant (PCHIP, Fritsch-Carlson,
 `scipy.interpolate.PchipInterpolator`) through the points, which keeps the curve monotone between
@@ -23,7 +22,7 @@ from scipy.interpolate import PchipInterpolator
 from seadesign.effects.base import Effect, Param, Scales, Search
 from seadesign.errors import ConfigError, DataError
 
-STOP_REASONS = ("target_reached", "limit_point", "bifurcation", "contact", "unconverged")
+STOP_REASONS = ("target_reached", "limit_point", "bifurcation", "contact", "strain_limit", "unconverged")
 
 
 class CurveRangeError(DataError):
@@ -43,8 +42,8 @@ class TorqueCurve:
     def __post_init__(self) -> None:
         th, tq = np.asarray(self.rotation_rad, float), np.asarray(self.torque_Nm, float)
         field = "torque_curve"
-        if th.ndim != 1 or th.shape != tq.shape or th.size < 3:
-            raise ConfigError(f"{field}: rotation_rad and torque_Nm must be lists of equal length, at least 3 "
+        if th.ndim != 1 or th.shape != tq.shape or th.size < 2:
+            raise ConfigError(f"{field}: rotation_rad and torque_Nm must be lists of equal length, at least 2 "
                               f"points; got {th.size} and {tq.size}")
         if not (np.isfinite(th).all() and np.isfinite(tq).all()):
             raise ConfigError(f"{field}: rotation_rad and torque_Nm must be finite numbers")
