@@ -18,11 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from seadesign.candidates import check_candidate, find_candidate
 from seadesign.fea.ccx import run_ccx, write_load_case_decks
 from seadesign.fea.loadcases import analyse
 from seadesign.mesh import mesh_part
-from seadesign.study import load_study
+from seadesign.design.study import load_study
 
 
 def main() -> None:
@@ -41,13 +40,13 @@ def main() -> None:
 
     stages: dict[str, float] = {}
     t = time.perf_counter()
-    checked = check_candidate(st, find_candidate(st, args.beams, args.thickness_mm))
+    checked, part = st.check(st.candidate(beam_count=args.beams, beam_thickness_mm=args.thickness_mm))
     stages["CAD + validity"] = time.perf_counter() - t
     if not checked.valid:
         raise SystemExit(f"candidate is invalid: {checked.reasons}")
     with tempfile.TemporaryDirectory() as cache:  # fresh: no cached mesh
         t = time.perf_counter()
-        mesh = mesh_part(checked.part.solid, checked.part.interfaces, across, args.thickness_mm,
+        mesh = mesh_part(part.solid, part.interfaces, across, args.thickness_mm,
                          cache_dir=cache, backend=args.backend, elements_per_circle=per_circle,
                          layers=st.mesh.mesh_part_options()["layers"] if args.backend == "gmsh" else 0)
         t_mesh = time.perf_counter() - t
@@ -58,7 +57,7 @@ def main() -> None:
     a = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, lc.stall_torque_Nm,
                 lc.impact_torque_Nm, st.bearing_radius_mm)
     t_fea = time.perf_counter() - t
-    r = a.results
+    r = a.results.columns()
     for key in ("setup", "assembly", "factorization", "solve", "stress"):
         stages[f"FEA {key}" + (" (L2 projection, invariants)" if key == "stress" else "")] = r[f"time_{key}_s"]
     stages["FEA other (load-case numbers)"] = t_fea - sum(r[f"time_{k}_s"] for k in ("setup", "assembly", "factorization", "solve", "stress"))

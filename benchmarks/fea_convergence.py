@@ -21,12 +21,11 @@ import time
 
 import numpy as np
 
-from seadesign.candidates import check_candidate, find_candidate
 from seadesign.fea.convergence import richardson
 from seadesign.fea.loadcases import analyse
 from seadesign.mesh import mesh_part
-from seadesign.stages import COARSENING, CONVERGENCE_ORDER
-from seadesign.study import load_study
+from seadesign.sweep.stages import COARSENING, CONVERGENCE_ORDER
+from seadesign.design.study import load_study
 
 
 def k_at(st, part, width, refinement, backend, cache_dir) -> tuple[float, float, int, float]:
@@ -40,7 +39,7 @@ def k_at(st, part, width, refinement, backend, cache_dir) -> tuple[float, float,
     m, lc = st.material, st.load_cases
     r = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, lc.stall_torque_Nm,
                 lc.impact_torque_Nm, st.bearing_radius_mm).results
-    return r["k_Nm_per_rad"], r["stall_von_mises_max_MPa"], len(mesh.tets), time.perf_counter() - t
+    return r.k_Nm_per_rad, r.stall.von_mises_max.MPa, len(mesh.tets), time.perf_counter() - t
 
 
 def main() -> None:
@@ -60,11 +59,11 @@ def main() -> None:
     parts = []
     for spec in args.candidates.split(","):
         n, w = spec.split("x")
-        checked = check_candidate(st, find_candidate(st, int(n), float(w)))
+        checked, part = st.check(st.candidate(beam_count=int(n), beam_thickness_mm=float(w)))
         if not checked.valid:
             print(f"{spec}: invalid ({'; '.join(checked.reasons)})")
             continue
-        parts.append((int(n), float(w), checked.part))
+        parts.append((int(n), float(w), part))
     with tempfile.TemporaryDirectory() as cache:
         for n, w, part in parts:
             hs, ks, peaks = [], [], []

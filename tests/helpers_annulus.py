@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from seadesign.mesh.tetmesh import build_tetmesh
-from seadesign.part import Interfaces
+from seadesign.design.interfaces import Interfaces
 
 
 def annulus_interfaces(a_mm: float, b_mm: float, h_mm: float) -> Interfaces:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import cadquery as cq
 import numpy as np
 
-from seadesign.part import Hole, Interfaces
+from seadesign.design.interfaces import Hole, Interfaces
 
 
 def holed_annulus() -> tuple[cq.Solid, Interfaces]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from seadesign.study import DEFAULT_STUDY
+from seadesign.design.study import DEFAULT_STUDY
 
 
 def write_tiny_study(folder: Path, name: str = "tiny", **replace: str) -> Path:

@@ -5,9 +5,8 @@ import pytest
 import trimesh
 
 from conftest import shared_path
-from seadesign.candidates import check_candidate
-from seadesign.export import tessellate
-from seadesign.study import load_study
+from seadesign.design.export import tessellate
+from seadesign.design.study import load_study
 
 
 def _surface_distances(a: trimesh.Trimesh, b: trimesh.Trimesh, n: int, seed: int) -> np.ndarray:
@@ -23,11 +22,12 @@ def test_bitbots_part_is_reproduced():
     # the file's axis is Y: rotate +90 deg about x so it becomes +z (x, y, z -> x, -z, y), no mirroring
     stl.vertices = np.c_[stl.vertices[:, 0], -stl.vertices[:, 2], stl.vertices[:, 1]]
     study = load_study("bitbots_shoulder")
-    c = check_candidate(study, study.candidates()[0])
+    c, part = study.check(study.candidates()[0])
     assert c.valid, c.reasons
-    ours = tessellate(c.part.solid, tolerance_mm=0.01)
-    assert c.part.volume_mm3 == pytest.approx(stl.volume, rel=0.02)
-    assert ours.volume == pytest.approx(stl.volume, rel=0.02)
+    ours = tessellate(part.solid, tolerance_mm=0.01)
+    # measured: volume +0.031 % (CAD) and -0.017 % (tessellated), mean distance 0.0055 mm, 99th percentile 0.050 mm
+    assert c.volume_mm3 == pytest.approx(stl.volume, rel=1e-3)
+    assert ours.volume == pytest.approx(stl.volume, rel=1e-3)
     d = np.concatenate([_surface_distances(ours, stl, 20000, 1), _surface_distances(stl, ours, 20000, 2)])
-    assert d.mean() < 0.3  # mm, symmetric mean surface distance
-    assert np.percentile(d, 99) < 0.3
+    assert d.mean() < 0.02  # mm, symmetric mean surface distance
+    assert np.percentile(d, 99) < 0.15

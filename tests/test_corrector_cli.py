@@ -15,7 +15,7 @@ from tests.conftest import shared_path
 
 
 def _spring(tmp_path, spring_dict):
-    from seadesign.handoff import write_spring
+    from seadesign.design.spring import write_spring
 
     return write_spring(spring_dict, tmp_path / "spring.json")
 

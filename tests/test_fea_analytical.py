@@ -24,8 +24,8 @@ def _k_error(mesh, order: int, nu: float) -> float:
     return 1.0 / sol.hub_motion[5] / annulus_k_Nm_per_rad(A, B, H, E, nu) - 1.0
 
 
-def test_quadratic_stiffness_within_1_percent(mesh):
-    assert abs(_k_error(mesh, 2, NU)) < 0.01
+def test_quadratic_stiffness_within_1e_4(mesh):
+    assert abs(_k_error(mesh, 2, NU)) < 1e-4  # measured 2.1e-5
 
 
 def test_linear_elements_lock_at_tpu_poisson_ratio(mesh):
@@ -39,7 +39,7 @@ def test_peak_shear_and_l2_projection(mesh):
     sol = solve_unit_torsion(mesh, E, NU)
     at_vertices = vertex_stresses(sol.emesh, sol.displacement_m, E, NU)
     projected = invariants(project_to_nodes(sol.emesh, at_vertices))["max_shear"]
-    assert projected.max() == pytest.approx(annulus_peak_shear_Pa(A, H, 1.0), rel=0.02)
+    assert projected.max() == pytest.approx(annulus_peak_shear_Pa(A, H, 1.0), rel=0.03)  # measured 1.1 %
 
     # L2 projection is closer to tau(r) = T / (2 pi r^2 h) than raw element-vertex values
     r = np.hypot(*sol.emesh.nodes_m[:, :2].T) * 1e-3**-1
@@ -52,22 +52,22 @@ def test_peak_shear_and_l2_projection(mesh):
 
 def test_load_cases_on_annulus(mesh):
     torque = 2.0
-    res = analyse(mesh, E, NU, 4e6, stall_torque_Nm=torque, impact_torque_Nm=3.0, bearing_radius_mm=A).results
-    k = annulus_k_Nm_per_rad(A, B, H, E, NU)
-    assert res["k_Nm_per_rad"] == pytest.approx(k, rel=0.01)
-    assert res["stall_rotation_rad"] == pytest.approx(torque / k, rel=0.01)
-    assert res["stall_bearing_displacement_mm"] == pytest.approx(torque / k * A, rel=0.01)
-    assert res["equilibrium_rel_error"] < 1e-6
-    assert res["stall_max_shear_max_MPa"] == pytest.approx(annulus_peak_shear_Pa(A, H, torque) * 1e-6, rel=0.02)
-    # pure shear: von Mises = sqrt(3) tau, principal stresses +-tau
-    assert res["impact_von_mises_max_MPa"] == pytest.approx(np.sqrt(3) * res["impact_max_shear_max_MPa"], rel=0.02)
+    res = analyse(mesh, E, NU, 4e6, stall_torque_Nm=torque, impact_torque_Nm=3.0, bearing_radius_mm=A).results.columns()
+    k = annulus_k_Nm_per_rad(A, B, H, E, NU)  # measured errors: k 2.1e-5, peak shear 1.1 %, equilibrium 2e-12
+    assert res["k_Nm_per_rad"] == pytest.approx(k, rel=1e-4)
+    assert res["stall_rotation_rad"] == pytest.approx(torque / k, rel=1e-4)
+    assert res["stall_bearing_displacement_mm"] == pytest.approx(torque / k * A, rel=1e-4)
+    assert res["equilibrium_rel_error"] < 1e-10
+    assert res["stall_max_shear_max_MPa"] == pytest.approx(annulus_peak_shear_Pa(A, H, torque) * 1e-6, rel=0.03)
+    # pure shear: von Mises = sqrt(3) tau (measured 2.7e-5), principal stresses +-tau
+    assert res["impact_von_mises_max_MPa"] == pytest.approx(np.sqrt(3) * res["impact_max_shear_max_MPa"], rel=2e-4)
     # principal peaks are +-tau plus the discrete pressure error at the bore's rigid edges, which
     # nu = 0.48 amplifies (lambda = 24 mu times a small divergence error): measured +18 % / -35 % here
     tau_impact = annulus_peak_shear_Pa(A, H, 3.0) * 1e-6
     assert res["impact_principal_1_max_MPa"] == pytest.approx(tau_impact, rel=0.4)
     assert res["impact_principal_3_min_MPa"] == pytest.approx(-tau_impact, rel=0.4)
     # the bore is one coupled surface: its resultant force vanishes, the torque goes through it
-    assert res["impact_reaction_per_bolt_N"] < 1e-6 * 3.0 / (A * 1e-3)
+    assert res["impact_reaction_per_bolt_N"] < 1e-8  # N; measured 4e-10 against the 600 N on the bore
     assert res["safety_factor"] == pytest.approx(4.0 / res["impact_von_mises_max_MPa"], rel=1e-9)
 
 

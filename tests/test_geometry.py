@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 import trimesh
 
-from seadesign.candidates import check_candidate
-from seadesign.export import write_step, write_stl
-from seadesign.geometry import build_part
-from seadesign.params import BoltPattern, GeometryParams
-from seadesign.study import load_study
-from seadesign.validity import check
+from seadesign.design.candidate import Candidate
+from seadesign.design.export import write_step, write_stl
+from seadesign.design.geometry import build_part
+from seadesign.design.params import BoltPattern, GeometryParams
+from seadesign.design.study import load_study
+from seadesign.design.validity import check
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +23,7 @@ def study():
 
 def _plain(study, **changes) -> GeometryParams:
     """A default-study candidate with changes (e.g. no fillet)."""
-    return dataclasses.replace(study.params(5, 6.0), **changes)
+    return dataclasses.replace(study.candidate(5, 6.0).params, **changes)
 
 
 def test_zero_beams_volume_is_hub_plus_ring_by_hand(study):
@@ -58,7 +58,7 @@ def _inside_profile(p: GeometryParams, x: np.ndarray, y: np.ndarray) -> np.ndarr
 
 @pytest.mark.parametrize("n, t", [(3, 4.0), (5, 6.0), (6, 8.0)])
 def test_profile_area_matches_independent_integration(study, n, t):
-    p = dataclasses.replace(study.params(n, t), fillet_radius_mm=0.0)
+    p = dataclasses.replace(study.candidate(n, t).params, fillet_radius_mm=0.0)
     part = build_part(p)
     h = 0.04  # mm grid
     g = np.arange(-p.ring_outer_radius_mm, p.ring_outer_radius_mm, h) + h / 2
@@ -68,7 +68,7 @@ def test_profile_area_matches_independent_integration(study, n, t):
 
 
 def test_profile_is_rotationally_symmetric_and_one_handed(study):
-    p = dataclasses.replace(study.params(5, 6.0), fillet_radius_mm=0.0)
+    p = dataclasses.replace(study.candidate(5, 6.0).params, fillet_radius_mm=0.0)
     g = np.linspace(-30, 30, 601)
     x, y = np.meshgrid(g, g)
     base = _inside_profile(p, x, y)
@@ -101,21 +101,21 @@ def test_fillets_add_material_at_the_roots(study):
 
 def test_known_good_candidates_are_valid(study):
     for n, t in [(3, 4.0), (5, 6.0), (10, 4.0), (6, 8.0)]:
-        c = check_candidate(study, study.params(n, t))
+        c, part = study.check(study.candidate(n, t))
         assert c.valid, (n, t, c.reasons)
-        assert c.part.solid.isValid()
-        assert c.mass_kg == pytest.approx(c.part.volume_mm3 * 1e-9 * 1190.0)
+        assert part.solid.isValid()
+        assert c.mass_kg == pytest.approx(part.volume_mm3 * 1e-9 * 1190.0)
 
 
 @pytest.mark.parametrize("n, t", [(9, 6.0), (9, 8.0), (10, 8.0)])
 def test_crowded_beams_touch(study, n, t):
-    reasons = check_candidate(study, study.params(n, t)).reasons
+    reasons = study.check(study.candidate(n, t))[0].reasons
     assert any("neighbouring beams" in r for r in reasons), reasons
 
 
 def test_clearance_threshold_is_computed(study):
     # 7 x 8 mm leaves about 0.79 mm between beams: invalid at 0.8, valid at 0.7
-    p = study.params(7, 8.0)
+    p = study.candidate(7, 8.0).params
     part = build_part(p)
     strict = check(part, study.validity)
     loose = check(part, dataclasses.replace(study.validity, min_clearance_mm=0.7))
@@ -125,27 +125,28 @@ def test_clearance_threshold_is_computed(study):
 
 def test_degenerate_tight_arc_is_invalid(study):
     # beam arc radius just above half the width: the inner arc shrinks to a tiny edge
-    base = dict(study.base, arc_radius_mm=4.05)
-    base["ring_bolts"] = dataclasses.replace(base["ring_bolts"], circle_diameter_mm=2 * (14 + 8.1 + 4))
-    reasons = check_candidate(study, GeometryParams(beam_count=4, beam_thickness_mm=8.0, **base)).reasons
+    base = study.candidate(4, 8.0).params
+    p = dataclasses.replace(base, arc_radius_mm=4.05,
+                            ring_bolts=dataclasses.replace(base.ring_bolts, circle_diameter_mm=2 * (14 + 8.1 + 4)))
+    reasons = study.check(Candidate((), p))[0].reasons
     assert any("degenerate feature" in r for r in reasons), reasons
 
 
 def test_bolt_hole_cutting_a_gap_is_invalid(study):
     # ring holes pushed onto the ring's inner edge open into the gaps between beams
     p = _plain(study, ring_bolts=BoltPattern(8, 2 * 24.5, 3.2, 22.5))
-    reasons = check_candidate(study, p).reasons
+    reasons = study.check(Candidate((), p))[0].reasons
     assert any("ring bolt hole" in r and "gap" in r for r in reasons), reasons
 
 
 def test_stl_read_back_and_step(study, tmp_path):
-    c = check_candidate(study, study.params(5, 6.0))
-    stl = write_stl(c.part.solid, tmp_path / "part.stl", tolerance_mm=0.01)
+    c, part = study.check(study.candidate(5, 6.0))
+    stl = write_stl(part.solid, tmp_path / "part.stl", tolerance_mm=0.01)
     mesh = trimesh.load(stl, force="mesh")
     assert mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0
-    assert mesh.volume == pytest.approx(c.part.volume_mm3, rel=5e-3)
+    assert mesh.volume == pytest.approx(c.volume_mm3, rel=5e-3)
     assert np.allclose(mesh.bounds[:, 2], [0.0, 9.0], atol=1e-6)  # mm, axis +z
-    step = write_step(c.part.solid, tmp_path / "part.step")
+    step = write_step(part.solid, tmp_path / "part.step")
     assert step.read_text(errors="ignore").startswith("ISO-10303-21")
 
 
@@ -153,7 +154,7 @@ def test_sliver_gaps_are_detected(study):
     # 6 x 8 mm gaps taper into long slits where the outer arcs meet the ring almost tangentially;
     # 5 x 6 mm gaps have no such slit. A printer that cannot keep 1.5 mm slits open fuses the first.
     rules = dataclasses.replace(study.validity, min_feature_mm=1.5)
-    slit = check(build_part(study.params(6, 8.0)), rules)
-    open_ = check(build_part(study.params(5, 6.0)), rules)
+    slit = check(build_part(study.candidate(6, 8.0).params), rules)
+    open_ = check(build_part(study.candidate(5, 6.0).params), rules)
     assert any(r.startswith("sliver") for r in slit), slit
     assert not any(r.startswith("sliver") for r in open_), open_

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from seadesign.errors import SpringFileError
-from seadesign.handoff import load_spring, validate_spring, write_spring
+from seadesign.design.spring import load_spring, torque_curve, validate_spring, write_spring
 
 
 def test_valid_spring_round_trips(spring_file, spring_dict):
@@ -43,3 +43,32 @@ def test_missing_and_malformed_files(tmp_path):
     bad.write_text("{not json")
     with pytest.raises(SpringFileError, match="not valid JSON"):
         load_spring(bad)
+
+
+def test_schema_1_files_are_still_read(spring_dict):
+    assert spring_dict["schema_version"] == 1 and validate_spring(spring_dict)
+    assert torque_curve(spring_dict) is None
+
+
+def _curve(**changes):
+    return {"rotation_rad": [0.0, 0.1, 0.2, 0.3], "torque_Nm": [0.0, 1.8, 3.5, 4.9], "source": "fea_large_deflection",
+            "stop_reason": "limit_point", "hard_stop": False, **changes}
+
+
+def test_schema_2_carries_a_torque_curve(spring_dict):
+    doc = dict(spring_dict, schema_version=2, torque_curve=_curve())
+    curve = torque_curve(validate_spring(doc))
+    assert curve.rotation_rad == (0.0, 0.1, 0.2, 0.3) and curve.torque_Nm[-1] == 4.9
+    assert curve.stop_reason == "limit_point" and not curve.hard_stop
+
+
+@pytest.mark.parametrize("changes, problem", [
+    ({"torque_Nm": [0.0, 1.8, 1.7, 4.9]}, "increase strictly"),
+    ({"rotation_rad": [0.0, 0.1, 0.2]}, "3 points"),
+    ({"rotation_rad": [0.05, 0.1, 0.2, 0.3]}, "not at \\(0, 0\\)"),
+    ({"stop_reason": "gave up"}, "torque_curve/stop_reason"),
+    ({"torque_Nm": [0.0, -1.0, 3.5, 4.9]}, "torque_curve/torque_Nm/1"),
+])
+def test_bad_torque_curve_names_the_field(spring_dict, changes, problem):
+    with pytest.raises(SpringFileError, match=problem):
+        validate_spring(dict(spring_dict, schema_version=2, torque_curve=_curve(**changes)))

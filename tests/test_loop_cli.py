@@ -62,8 +62,8 @@ def test_thesis_worked_example(tmp_path, spring_file):
     assert cal["held_out_rmse_after"] < cal["held_out_rmse_before"] / 100
     # the scale is relative to the thesis FEA's material (generic TPU), so the sweep takes the fitted modulus
     from seadesign.cli.sweep_cmds import apply_calibration
-    from seadesign.materials import load_material
-    from seadesign.study import load_study
+    from seadesign.design.materials import load_material
+    from seadesign.design.study import load_study
 
     study, _ = apply_calibration(load_study("wolfgang_knee"), tmp_path / "thesis_calibration.json")
     e_thesis = load_material("generic_tpu").youngs_modulus_Pa

@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from seadesign.errors import ConfigError
-from seadesign.materials import MATERIALS_DIR, load_material, load_material_file
+from seadesign.design.materials import MATERIALS_DIR, load_material, load_material_file
 
 GOOD = """
 name = "Test TPU"

@@ -9,7 +9,7 @@ from helpers_parts import holed_annulus
 from seadesign.errors import MeshError
 from seadesign.mesh import mesh_part
 from seadesign.mesh.tetmesh import boundary_facets
-from seadesign.part import Interfaces
+from seadesign.design.interfaces import Interfaces
 
 @pytest.fixture(scope="module")
 def part():

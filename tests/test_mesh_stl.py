@@ -40,7 +40,7 @@ def test_bitbots_part_meshes_and_solves(bitbots, tmp_path):
     assert {f"hub_hole_{i}" for i in range(4)} | {f"ring_hole_{i}" for i in range(6)} <= set(mesh.boundaries)
     vol = np.abs(np.linalg.det(mesh.points_mm[mesh.tets[:, 1:]] - mesh.points_mm[mesh.tets[:, :1]])).sum() / 6
     assert vol == pytest.approx(10520, rel=0.02)  # DOMAIN.md: 10,520 mm^3
-    res = analyse(mesh, 12e6, 0.48, 4e6, 11.7, 27.7, bearing_radius_mm=ifc.hub_radius_mm).results
+    res = analyse(mesh, 12e6, 0.48, 4e6, 11.7, 27.7, bearing_radius_mm=ifc.hub_radius_mm).results.columns()
     assert res["equilibrium_rel_error"] < 1e-6
     assert res["k_Nm_per_rad"] > 0 and res["impact_bolt_count"] == 4
     # four bolts on an 8 mm radius carry the impact torque: about T / (4 r) each (each hole wall

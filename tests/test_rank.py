@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from seadesign.rank import pareto_front, rank
-from seadesign.study import load_study
+from seadesign.sweep.rank import pareto_front, rank
+from seadesign.design.study import load_study
 
 
 def test_pareto_front_of_a_known_set():

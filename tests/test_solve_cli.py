@@ -9,7 +9,7 @@ import pytest
 from click.testing import CliRunner
 
 from seadesign.cli import main
-from seadesign.study import load_study
+from seadesign.design.study import load_study
 from sweep_helpers import write_tiny_study
 
 
@@ -26,7 +26,7 @@ def solved(tmp_path_factory):
 
 def test_results_are_printed_and_written_with_units(solved):
     study, out, _, printed = solved
-    doc = json.loads((out / "3_beams_8mm.json").read_text())
+    doc = json.loads((out / "3beams_8mm.json").read_text())
     r = doc["results"]
     assert r["equilibrium_rel_error"] < 1e-6
     assert r["stall_rotation_rad"] == pytest.approx(study.load_cases.stall_torque_Nm / r["k_Nm_per_rad"], rel=1e-9)
@@ -38,11 +38,11 @@ def test_vtu_hub_bolt_walls_move_as_one_rigid_body_at_the_printed_rotation(solve
     import pyvista as pv
 
     study, out, _, _ = solved
-    r = json.loads((out / "3_beams_8mm.json").read_text())["results"]
-    grid = pv.read(out / "3_beams_8mm.vtu")
+    r = json.loads((out / "3beams_8mm.json").read_text())["results"]
+    grid = pv.read(out / "3beams_8mm.vtu")
     x = np.asarray(grid.points)  # mm
     u = np.asarray(grid.point_data["stall_displacement_mm"])
-    holes = study.params(3, 8.0).interfaces().hub_holes
+    holes = study.candidate(3, 8.0).params.interfaces().hub_holes
     centres = np.array([[h.x_mm, h.y_mm] for h in holes])
     dist = np.min(np.linalg.norm(x[:, None, :2] - centres[None], axis=2), axis=1)
     wall = np.abs(dist - holes[0].radius_mm) < 1e-6

@@ -7,26 +7,26 @@ from pathlib import Path
 import pytest
 
 from seadesign.errors import ConfigError
-from seadesign.study import DEFAULT_STUDY, load_study
+from seadesign.design.study import DEFAULT_STUDY, load_study
 
 
 def test_default_study():
     s = load_study()
     assert s.name == "wolfgang_knee"
     assert len(s.candidates()) == 24
-    assert {(c.beam_count, c.beam_thickness_mm) for c in s.candidates()} == {
+    assert {(c.params.beam_count, c.params.beam_thickness_mm) for c in s.candidates()} == {
         (n, t) for n in range(3, 11) for t in (4.0, 6.0, 8.0)}
     # thesis eq. 5.1: tau = r F sin(theta) = 0.2038 m * 4 * 39.23 N * sin 60 deg = 27.70 Nm
     assert s.load_cases.impact_torque_Nm == pytest.approx(0.2038 * 4 * 39.23 * math.sin(math.pi / 3))
     assert round(s.load_cases.impact_torque_Nm, 2) == 27.70
-    assert s.base["hub_radius_mm"] == 14.0
-    hub = s.base["hub_bolts"]
+    assert all(c.params.hub_radius_mm == 14.0 for c in s.candidates())
+    hub = s.candidates()[0].params.hub_bolts
     assert (hub.count, hub.circle_diameter_mm) == (8, 22.0)
 
 
 def test_bitbots_study_loads():
     s = load_study("bitbots_shoulder")
-    (p,) = s.candidates()
+    ((_, p),) = [(c, c.params) for c in s.candidates()]
     assert (p.beam_count, p.beam_thickness_mm, p.ring_outer_radius_mm) == (6, 3.0, 25.0)
 
 
@@ -81,3 +81,13 @@ def test_every_lazy_command_resolves_and_every_command_is_listed():
     for module in set(COMMAND_MODULES.values()):
         importlib.import_module(f"seadesign.cli.{module}")
     assert set(main.commands) == set(COMMAND_MODULES)  # no command defined but missing from the map
+
+
+def test_old_duplicate_lower_leg_key_loads_with_a_deprecation_message(tmp_path):
+    same = _variant(tmp_path, r"^foot_cell_count = 4", "foot_cell_count = 4\nlower_leg_m = 0.2038")
+    with pytest.warns(FutureWarning, match="load_cases.lower_leg_m is deprecated"):
+        s = load_study(same)
+    assert s.load_cases.impact_torque_Nm == pytest.approx(load_study().load_cases.impact_torque_Nm, rel=1e-15)
+    differ = _variant(tmp_path, r"^foot_cell_count = 4", "foot_cell_count = 4\nlower_leg_m = 0.25")
+    with pytest.raises(ConfigError, match=r"load_cases.lower_leg_m \(0.25 m\) differs from robot.lower_leg_m"):
+        load_study(differ)

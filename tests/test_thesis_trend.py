@@ -8,10 +8,10 @@ import dataclasses
 
 import pytest
 
-from seadesign.cache import Cache
-from seadesign.stages import COARSENING
-from seadesign.study import load_study
-from seadesign.sweep import run_sweep
+from seadesign.run.cache import Cache
+from seadesign.sweep.stages import COARSENING
+from seadesign.design.study import load_study
+from seadesign.sweep.runner import run_sweep
 
 
 @pytest.mark.slow

@@ -16,7 +16,7 @@ from seadesign.corrector.report import write_table
 from seadesign.corrector.splits import SPLITS
 from seadesign.corrector.train import TrainConfig
 from seadesign.corrector.workflow import DEFAULT_HISTORY, candidate_name, evaluate_bundles, train_bundle
-from seadesign.handoff import load_spring
+from seadesign.design.spring import load_spring
 from seadesign.twin import thesis_protocol
 
 

@@ -19,7 +19,7 @@ from seadesign.data import (
 )
 from seadesign.data.artefacts import Thresholds
 from seadesign.effects import EffectChain
-from seadesign.handoff import load_spring
+from seadesign.design.spring import load_spring
 from seadesign.twin import (
     BenchProtocol,
     KneeConfig,

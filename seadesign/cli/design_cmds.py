@@ -6,10 +6,9 @@ from pathlib import Path
 
 import click
 
-from seadesign.candidates import check_candidate, find_candidate
 from seadesign.cli import main
-from seadesign.export import export_candidate
-from seadesign.study import DEFAULT_STUDY, load_study
+from seadesign.cli.candidate_options import candidate_options, pick_candidate
+from seadesign.design.study import DEFAULT_STUDY, load_study
 
 STUDY_ARG = click.argument("study", default=str(DEFAULT_STUDY.stem), required=False)
 OUT_OPT = click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=Path("exports"),
@@ -26,26 +25,31 @@ def geometry(study: str) -> None:
     Volume in mm^3, mass in g (from the study material's density).
     """
     s = load_study(study)
-    click.echo(f"study {s.name}: {len(s.candidates())} candidates, material {s.material.name}")
-    click.echo(f"{'beams':>5} {'thickness_mm':>12} {'valid':>5} {'volume_mm3':>11} {'mass_g':>7}  reason")
-    for params in s.candidates():
-        c = check_candidate(s, params)
-        click.echo(f"{params.beam_count:>5} {params.beam_thickness_mm:>12g} {'yes' if c.valid else 'no':>5} "
-                   f"{c.part.volume_mm3:>11.1f} {1000 * c.mass_kg:>7.2f}  {'; '.join(c.reasons)}")
+    candidates = s.candidates()
+    click.echo(f"study {s.name}: {len(candidates)} candidates, material {s.material.name}")
+    width = max(len("candidate"), *(len(c.name) for c in candidates))
+    click.echo(f"{'candidate':<{width}} {'valid':>5} {'volume_mm3':>11} {'mass_g':>7}  reason")
+    for candidate in candidates:
+        c, _ = s.check(candidate)
+        click.echo(f"{c.name:<{width}} {'yes' if c.valid else 'no':>5} {c.volume_mm3:>11.1f} {1000 * c.mass_kg:>7.2f}  "
+                   f"{'; '.join(c.reasons)}")
 
 
 @main.command()
 @STUDY_ARG
-@click.option("--beams", "beam_count", type=int, required=True, help="Beam count of the candidate.")
-@click.option("--thickness-mm", type=float, required=True, help="Beam thickness (in-plane width) in mm.")
+@candidate_options
 @TOL_OPT
 @OUT_OPT
-def export(study: str, beam_count: int, thickness_mm: float, tolerance_mm: float, out_dir: Path) -> None:
-    """Write STL and STEP (mm) of one valid candidate of STUDY to OUT/<study>/."""
+def export(study: str, beams: int | None, thickness_mm: float | None, param: tuple[str, ...], tolerance_mm: float,
+           out_dir: Path) -> None:
+    """Write STL and STEP (mm) of one valid candidate of STUDY to OUT/<study>/ (the candidate by its
+    design-axis values: --param KEY=VALUE, or --beams N --thickness-mm T)."""
+    from seadesign.design.export import export_candidate
+
     s = load_study(study)
-    c = check_candidate(s, find_candidate(s, beam_count, thickness_mm))
+    c, part = s.check(pick_candidate(s, beams, thickness_mm, param))
     if not c.valid:
-        raise click.UsageError(f"candidate {beam_count} beams x {thickness_mm:g} mm is invalid: {'; '.join(c.reasons)}")
-    for path in export_candidate(c, out_dir / s.name, tolerance_mm):
+        raise click.UsageError(f"candidate {c.name} is invalid: {'; '.join(c.reasons)}")
+    for path in export_candidate(c, part, out_dir / s.name, tolerance_mm):
         click.echo(f"wrote {path}")
 

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from seadesign.cli import main
+from seadesign.cli.candidate_options import candidate_options, pick_candidate
 from seadesign.errors import ConfigError
 
 SUMMARY = (
@@ -33,8 +34,7 @@ SUMMARY = (
 
 @main.command()
 @click.argument("study", required=False)
-@click.option("--beams", type=int, help="Beam count of the study candidate.")
-@click.option("--thickness-mm", type=float, help="Beam thickness (in-plane width, mm) of the study candidate.")
+@candidate_options
 @click.option("--stl", "stl", type=click.Path(dir_okay=False, path_type=Path), help="Solve this STL (mm) instead.")
 @click.option("--axis", type=click.Choice(["x", "y", "z"]), default="y", show_default=True, help="STL spring axis.")
 @click.option("--beam-width-mm", type=float, help="STL: beam width that sets the mesh size.")
@@ -54,18 +54,19 @@ SUMMARY = (
               help="Where to write NAME.json and NAME.vtu; default exports/<study or STL name>/.")
 @click.option("--export-ccx", "ccx_dir", type=click.Path(file_okay=False, path_type=Path),
               help="Also write CalculiX decks stall.inp and impact.inp here.")
-def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs, nu, yield_, stall_torque_nm,
+def solve(study, beams, thickness_mm, param, stl, axis, beam_width_mm, material, youngs, nu, yield_, stall_torque_nm,
           impact_torque_nm, bearing_radius_mm, elements_across_beam, elements_per_circle, backend, out_dir, ccx_dir) -> None:
     """Mesh and solve the stall and impact load cases of one part; print and write the results.
 
-    Either STUDY --beams N --thickness-mm T (a candidate of a study), or --stl FILE --beam-width-mm W.
+    Either STUDY and the candidate's design-axis values (--param KEY=VALUE, or --beams N
+    --thickness-mm T), or --stl FILE --beam-width-mm W.
     """
     from seadesign.fea.solve_part import solve_part
-    from seadesign.materials import load_material
-    from seadesign.study import load_study
+    from seadesign.design.materials import load_material
+    from seadesign.design.study import load_study
 
     if (stl is None) == (study is None):
-        raise ConfigError("give either a STUDY (with --beams and --thickness-mm) or --stl FILE, not both or neither")
+        raise ConfigError("give either a STUDY (with its candidate's axis values) or --stl FILE, not both or neither")
     st = load_study(study) if study is not None else load_study()
     if stl is not None:
         from seadesign.mesh import load_stl
@@ -81,16 +82,12 @@ def solve(study, beams, thickness_mm, stl, axis, beam_width_mm, material, youngs
         across, mesher = elements_across_beam or 3.0, backend or "pytetwild"
         per_circle, layers = elements_per_circle or 0.0, 0
     else:
-        if beams is None or thickness_mm is None:
-            raise ConfigError("the study form needs --beams N and --thickness-mm T")
-        from seadesign.candidates import check_candidate, find_candidate
-
-        checked = check_candidate(st, find_candidate(st, beams, thickness_mm))
+        checked, part = st.check(pick_candidate(st, beams, thickness_mm, param))
         if not checked.valid:
-            raise ConfigError(f"candidate {beams} beams / {thickness_mm:g} mm is invalid: {'; '.join(checked.reasons)}")
-        geometry, interfaces = checked.part.solid, checked.part.interfaces
+            raise ConfigError(f"candidate {checked.name} is invalid: {'; '.join(checked.reasons)}")
+        geometry, interfaces = part.solid, part.interfaces
         mat = load_material(material) if material else st.material
-        name, width = f"{beams}_beams_{thickness_mm:g}mm", thickness_mm
+        name, width = checked.stem, checked.params.beam_thickness_mm
         bearing = bearing_radius_mm or st.bearing_radius_mm
         across = elements_across_beam or st.mesh.elements_across_beam
         mesher = backend or st.mesh.backend

@@ -10,7 +10,7 @@ import pandas as pd
 from seadesign.cli import main
 from seadesign.data import clean, is_hanging, read_bench, read_recording
 from seadesign.errors import ConfigError
-from seadesign.handoff import load_spring
+from seadesign.design.spring import load_spring
 from seadesign.loop import CANDIDATES, ROLES, explain, from_frame
 from seadesign.loop.report import write_report
 from seadesign.loop.sea import ROBOT_DECLARED, bench_loop_data, calibration, robot_declared, robot_loop_data

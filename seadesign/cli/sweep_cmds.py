@@ -5,13 +5,15 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
+import shlex
+import sys
 from pathlib import Path
 
 import click
 
 from seadesign.cli import main
 from seadesign.errors import ConfigError
-from seadesign.study import DEFAULT_STUDY, Study, load_study
+from seadesign.design.study import DEFAULT_STUDY, Study, load_study
 
 
 CALIBRATION_KEYS = ("youngs_modulus_fitted_Pa", "youngs_modulus_Pa", "stiffness_scale")
@@ -41,7 +43,7 @@ def apply_calibration(study: Study, path: Path) -> tuple[Study, str]:
 @main.command()
 @click.argument("study", default=str(DEFAULT_STUDY.stem), required=False)
 @click.option("--jobs", type=click.IntRange(min=1), default=None,
-              help="Worker processes (count); default: all cores. 1 runs in this process.")
+              help="Worker processes (count); default: all cores.")
 @click.option("--quiet", is_flag=True, help="No progress display (for scripts); the summary is still printed.")
 @click.option("--executor", type=click.Choice(["local", "dask"]), default="local", show_default=True,
               help="local process pool, or a Dask distributed cluster.")
@@ -63,14 +65,34 @@ def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: s
     """Run every candidate of STUDY (geometry, validity, mesh, both load cases), rank them and write
     results.parquet/csv, plots, report.html/md, STL/STEP and spring.json to OUT/<study>/.
 
-    Interrupted sweeps resume; unchanged stages come from the cache. Units: lengths mm where
-    named, otherwise SI (N, Nm, rad, Pa).
+    Ctrl-C or SIGTERM stops it within a second or two, keeping every finished candidate; the same
+    command resumes, and unchanged stages come from the cache. Units: lengths mm where named,
+    otherwise SI (N, Nm, rad, Pa).
     """
-    from seadesign.cache import DEFAULT_CACHE_DIR, Cache
-    from seadesign.rank import calibration_summary, rank
+    from seadesign.run.interrupt import Interrupted, stop_on_signals
+    from seadesign.sweep.runner import SweepStopped
+
+    resume = "seadesign " + shlex.join(sys.argv[1:])
+    try:
+        with stop_on_signals():
+            _sweep(study, jobs, quiet, executor, scheduler, export_all, out_dir, calibration, cache_dir, tolerance_mm)
+    except SweepStopped as stop:
+        click.echo(f"stopped by {stop.signal}: {stop.saved} of {stop.total} candidates finished and saved in "
+                   f"{stop.rows_dir} (no half-written file left); resume with: {resume}", err=True)
+        click.get_current_context().exit(stop.exit_code)
+    except Interrupted as stop:
+        click.echo(f"stopped by {stop.signal}; finished candidates are saved; resume with: {resume}", err=True)
+        click.get_current_context().exit(stop.exit_code)
+
+
+def _sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: str | None, export_all: bool,
+           out_dir: Path, calibration: Path | None, cache_dir: Path | None, tolerance_mm: float) -> None:
+    """The sweep command's work (see `sweep`)."""
+    from seadesign.run.cache import DEFAULT_CACHE_DIR, Cache
+    from seadesign.sweep.rank import calibration_summary, rank
     from seadesign.report import write_outputs
-    from seadesign.stages import SolverSettings
-    from seadesign.sweep import run_sweep, sweep_settings
+    from seadesign.sweep.stages import SolverSettings
+    from seadesign.sweep.runner import run_sweep, sweep_settings
 
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
     s = load_study(study)

@@ -26,7 +26,7 @@ from seadesign.corrector.runtime import Corrector, FeedForward, HallPI, NetCorre
 from seadesign.corrector.splits import Split, make_split
 from seadesign.corrector.train import TrainConfig, TrainResult, fit
 from seadesign.errors import SeadesignError
-from seadesign.handoff import load_spring
+from seadesign.design.spring import load_spring
 from seadesign.twin import thesis_protocol
 
 DEFAULT_HISTORY = 3  # samples, for the history model when no --history is given

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from seadesign.constants import G_M_PER_S2 as G
+from seadesign.constants import G_M_PER_S2, WOLFGANG_LOWER_LEG_M, WOLFGANG_MASS_KG
 from seadesign.effects.base import Effect, Param, Scales, Search
+
 
 
 class Friction(Effect):
@@ -72,9 +73,9 @@ class StanceLoad(Effect):
     key = "ground_contact"
     summary = "stance: load -= W l2 sin(a2(angle)), weight W on a hip-over-ankle leg"
     parameters = (
-        Param("weight_N", "N", 0.5 * 8.0 * G, 0.0, 2000.0, "supported body weight W (on both legs together)"),
+        Param("weight_N", "N", 0.5 * WOLFGANG_MASS_KG * G_M_PER_S2, 0.0, 2000.0, "supported body weight W (on both legs together)"),
         Param("upper_leg_m", "m", 0.2, 0.01, 2.0, "thigh length l1"),
-        Param("lower_leg_m", "m", 0.2038, 0.01, 2.0, "shank length l2"),
+        Param("lower_leg_m", "m", WOLFGANG_LOWER_LEG_M, 0.01, 2.0, "shank length l2"),
     )
     reads = ("angle", "stance")
     writes = "load_torque"

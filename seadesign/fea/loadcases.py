@@ -1,4 +1,4 @@
-"""The study's two load cases from one factorization, as plain numbers with units in their names.
+"""The study's two load cases from one factorization, as typed results (`fea.results`).
 
 stall: stall torque on the hub (horn side), ring held -> rotation, bearing displacement, k.
 impact: impact torque on the ring (backplate side), hub held -> reactions at the hub bolts.
@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from seadesign.errors import SolverError
+from seadesign.fea.results import ImpactResult, LinearResults, SolveStats, StallResult, StressPeak
 from seadesign.fea.stress import invariants, project_to_nodes, vertex_stresses
 from seadesign.fea.torsion import MM, UnitTorsion, solve_unit_torsion
 from seadesign.mesh.tetmesh import TetMesh
@@ -29,7 +30,7 @@ class Analysis:
     unit: UnitTorsion
     stress_per_Nm_Pa: np.ndarray  # (N, 6) nodal stress per 1 Nm of hub torque, Voigt xx yy zz xy yz zx
     hub_torque_Nm: dict[str, float]  # load case -> equivalent hub torque (stall: +T, impact: -T)
-    results: dict[str, float]
+    results: LinearResults
 
     def displacement_m(self, case: str) -> np.ndarray:
         """(N, 3) displacement in m (impact: relative to the held hub, rigid motion removed)."""
@@ -48,17 +49,58 @@ class Analysis:
         return m[:3] + np.cross(m[3:], d)
 
 
-def _stress_keys(case: str, voigt_Pa: np.ndarray, nodes_mm: np.ndarray) -> dict[str, float]:
+def _stress_peaks(voigt_Pa: np.ndarray, nodes_mm: np.ndarray) -> dict[str, StressPeak]:
+    """Peak of each STRESS_NAMES measure (the minimum of principal_3) and where it is."""
     inv = invariants(voigt_Pa)
-    out: dict[str, float] = {}
+    out = {}
     for name in STRESS_NAMES:
         field = inv[name]
         i = int(np.argmin(field)) if name == "principal_3" else int(np.argmax(field))
-        tag = f"{case}_{name}_{'min' if name == 'principal_3' else 'max'}"
-        out[f"{tag}_MPa"] = float(field[i] * 1e-6)
-        for axis, c in zip("xyz", nodes_mm[i]):
-            out[f"{tag}_{axis}_mm"] = float(c)
+        x, y, z = (float(c) for c in nodes_mm[i])
+        out[f"{name}_{'min' if name == 'principal_3' else 'max'}"] = StressPeak(float(field[i] * 1e-6), x, y, z)
     return out
+
+
+def _results(unit: UnitTorsion, stress_per_Nm: np.ndarray, torque: dict[str, float], yield_strength_Pa: float,
+             bearing_radius_mm: float, stats: SolveStats) -> LinearResults:
+    """The load-case numbers of one unit solve at the given hub torques (stall +T, impact -T)."""
+    theta = float(unit.hub_motion[5])
+    nodes_mm = unit.emesh.nodes_m / MM
+    f = unit.nodal_force_N
+    ring = unit.ring_nodes
+    ring_torque = float(np.sum(unit.emesh.nodes_m[ring, 0] * f[ring, 1] - unit.emesh.nodes_m[ring, 1] * f[ring, 0]))
+    equilibrium = abs(ring_torque + 1.0)  # reaction torque must cancel the applied 1 Nm
+
+    # bearing circle at the reference plane, moving with the rigid hub
+    phi = np.linspace(0.0, 2 * np.pi, 720, endpoint=False)
+    circle = np.column_stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)]) * bearing_radius_mm * MM
+    bearing_per_Nm = float(np.linalg.norm(unit.hub_motion[:3] + np.cross(unit.hub_motion[3:], circle), axis=1).max())
+
+    bolt = [np.linalg.norm(f[nodes].sum(axis=0)) for nodes in unit.hub_groups.values()]
+    hub_nodes = np.unique(np.concatenate(list(unit.hub_groups.values())))
+    peak_nodal = float(np.linalg.norm(f[hub_nodes], axis=1).max())
+
+    t_stall, t_impact = torque["stall"], -torque["impact"]
+    peaks = {case: _stress_peaks(stress_per_Nm * t, nodes_mm) for case, t in torque.items()}
+    stall = StallResult(
+        torque_Nm=t_stall, rotation_rad=t_stall * theta, bearing_displacement_mm=t_stall * bearing_per_Nm / MM,
+        **peaks["stall"], safety_factor=yield_strength_Pa / (peaks["stall"]["von_mises_max"].MPa * 1e6))
+    impact = ImpactResult(
+        torque_Nm=t_impact, reaction_per_bolt_N=t_impact * float(max(bolt)),
+        reaction_per_bolt_min_N=t_impact * float(min(bolt)), bolt_count=float(len(bolt)),
+        peak_nodal_reaction_N=t_impact * peak_nodal, **peaks["impact"],
+        safety_factor=yield_strength_Pa / (peaks["impact"]["von_mises_max"].MPa * 1e6))
+    return LinearResults(k_Nm_per_rad=1.0 / theta, equilibrium_rel_error=equilibrium, stall=stall, impact=impact,
+                         stats=stats)
+
+
+def _stats(unit: UnitTorsion, mesh: TetMesh, order: int, t_stress: float) -> SolveStats:
+    t = unit.timings_s
+    return SolveStats(
+        element_order=float(order), dofs=float(unit.n_dofs), mesh_nodes=float(len(mesh.points_mm)),
+        mesh_tets=float(len(mesh.tets)), mesh_min_dihedral_deg=mesh.quality.min_dihedral_deg,
+        mesh_max_aspect_ratio=mesh.quality.max_aspect_ratio, time_setup_s=t["setup"], time_assembly_s=t["assembly"],
+        time_factorization_s=t["factorization"], time_solve_s=t["solve"], time_stress_s=t_stress)
 
 
 def analyse(
@@ -97,53 +139,8 @@ def analyse(
     theta = float(unit.hub_motion[5])
     if not theta > 0:
         raise SolverError(f"hub rotation per Nm is {theta:g} rad; the mesh or its couplings are broken")
-    nodes_mm = unit.emesh.nodes_m / MM
-    f = unit.nodal_force_N
-    ring = unit.ring_nodes
-    ring_torque = float(np.sum(unit.emesh.nodes_m[ring, 0] * f[ring, 1] - unit.emesh.nodes_m[ring, 1] * f[ring, 0]))
-    equilibrium = abs(ring_torque + 1.0)  # reaction torque must cancel the applied 1 Nm
-
-    # bearing circle at the reference plane, moving with the rigid hub
-    phi = np.linspace(0.0, 2 * np.pi, 720, endpoint=False)
-    circle = np.column_stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)]) * bearing_radius_mm * MM
-    bearing = unit.hub_motion[:3] + np.cross(unit.hub_motion[3:], circle)
-    bearing_per_Nm = float(np.linalg.norm(bearing, axis=1).max())
-
-    bolt = [np.linalg.norm(f[nodes].sum(axis=0)) for nodes in unit.hub_groups.values()]
-    hub_nodes = np.unique(np.concatenate(list(unit.hub_groups.values())))
-    peak_nodal = float(np.linalg.norm(f[hub_nodes], axis=1).max())
-
     torque = {"stall": float(stall_torque_Nm), "impact": -float(impact_torque_Nm)}
-    results: dict[str, float] = {
-        "k_Nm_per_rad": 1.0 / theta,
-        "stall_torque_Nm": float(stall_torque_Nm),
-        "stall_rotation_rad": stall_torque_Nm * theta,
-        "stall_bearing_displacement_mm": stall_torque_Nm * bearing_per_Nm / MM,
-        "impact_torque_Nm": float(impact_torque_Nm),
-        "impact_reaction_per_bolt_N": impact_torque_Nm * float(max(bolt)),
-        "impact_reaction_per_bolt_min_N": impact_torque_Nm * float(min(bolt)),
-        "impact_bolt_count": float(len(bolt)),
-        "impact_peak_nodal_reaction_N": impact_torque_Nm * peak_nodal,
-        "equilibrium_rel_error": equilibrium,
-    }
-    vm_max = 0.0
-    for case, t in torque.items():
-        keys = _stress_keys(case, stress * t, nodes_mm)
-        results.update(keys)
-        results[f"{case}_safety_factor"] = yield_strength_Pa / (keys[f"{case}_von_mises_max_MPa"] * 1e6)
-        vm_max = max(vm_max, keys[f"{case}_von_mises_max_MPa"] * 1e6)
-    results["safety_factor"] = yield_strength_Pa / vm_max
-    results.update(
-        {
-            "element_order": float(order),
-            "dofs": float(unit.n_dofs),
-            "mesh_nodes": float(len(mesh.points_mm)),
-            "mesh_tets": float(len(mesh.tets)),
-            "mesh_min_dihedral_deg": mesh.quality.min_dihedral_deg,
-            "mesh_max_aspect_ratio": mesh.quality.max_aspect_ratio,
-            **{f"time_{k}_s": v for k, v in unit.timings_s.items()},
-            "time_stress_s": t_stress,
-        }
-    )
+    results = _results(unit, stress, torque, yield_strength_Pa, bearing_radius_mm,
+                       _stats(unit, mesh, order, t_stress))
     return Analysis(unit=unit, stress_per_Nm_Pa=stress, hub_torque_Nm=torque, results=results)
 

@@ -9,7 +9,7 @@ from seadesign.fea.ccx import write_load_case_decks
 from seadesign.fea.export import write_results_json, write_vtu
 from seadesign.fea.loadcases import Analysis, analyse
 from seadesign.mesh import TetMesh, mesh_part
-from seadesign.part import Interfaces
+from seadesign.design.interfaces import Interfaces
 
 
 def solve_part(
@@ -39,7 +39,7 @@ def solve_part(
     t1 = time.perf_counter()
     a = analyse(mesh, youngs_modulus_Pa, poisson_ratio, yield_strength_Pa, stall_torque_Nm, impact_torque_Nm,
                 bearing_radius_mm)
-    results = {**a.results, "time_mesh_s": t1 - t0, "time_total_s": time.perf_counter() - t0}
+    results = {**a.results.columns(), "time_mesh_s": t1 - t0, "time_total_s": time.perf_counter() - t0}
     if out_dir is not None:
         out_dir = Path(out_dir)
         meta = {

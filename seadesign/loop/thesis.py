@@ -15,7 +15,7 @@ from seadesign.data import write_bench
 from seadesign.loop.engine import Explanation, explain
 from seadesign.loop.report import write_report
 from seadesign.loop.sea import bench_loop_data, calibration
-from seadesign.materials import load_material
+from seadesign.design.materials import load_material
 from seadesign.twin import BenchProtocol, bench_effects, simulate_bench
 
 K_MEASURED_NM_PER_RAD = 9.106

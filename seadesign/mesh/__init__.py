@@ -19,7 +19,7 @@ from seadesign.mesh import cache
 from seadesign.mesh.extrude import layer_count
 from seadesign.mesh.surface import load_stl, tessellate_solid
 from seadesign.mesh.tetmesh import MeshQuality, TetMesh, build_tetmesh
-from seadesign.part import Interfaces
+from seadesign.design.interfaces import Interfaces
 
 __all__ = ["BACKENDS", "MeshQuality", "TetMesh", "load_stl", "mesh_part"]
 
@@ -80,47 +80,14 @@ def mesh_part(
     in a child process limited to timeout_s; a failed, timed-out or oversized (> max_tets) attempt is retried `retries` times, then MeshError.
     Meshes are cached by content under cache_dir (default: cache.default_cache_dir()).
     """
-    if backend not in BACKENDS:
-        raise MeshError(f"mesh backend {backend!r} is unknown; use one of {', '.join(BACKENDS)}")
-    if not (elements_across_beam > 0 and beam_width_mm > 0):
-        raise MeshError(
-            f"elements_across_beam ({elements_across_beam}) and beam_width_mm ({beam_width_mm}) must be positive"
-        )
-    if layers < 0:
-        raise MeshError(f"layers={layers}: give a positive number of layers, or 0 to derive it from the size")
-    if elements_per_circle < 0 or (elements_per_circle > 0 and backend != "gmsh"):
-        raise MeshError(f"elements_per_circle={elements_per_circle:g}: curvature-based sizing needs backend 'gmsh' "
-                        "and a value >= 0; use 0 for a uniform mesh")
+    _check_options(backend, elements_across_beam, beam_width_mm, layers, elements_per_circle)
     size_mm = beam_width_mm / elements_across_beam
-    is_cad = hasattr(solid_or_surface, "exportBrep")
     t0 = time.perf_counter()
     if backend == "gmsh":
-        if not is_cad:
-            raise MeshError("the gmsh backend needs a CAD solid; mesh surfaces (STL) with backend='pytetwild'")
-        volume = float(solid_or_surface.Volume())
-        settings = {"backend": backend, "size_mm": size_mm, "per_circle": elements_per_circle}
-        section = prismatic_section(solid_or_surface) if sweep else None
-        if section is not None:
-            face, z0, thickness = section
-            settings["swept"] = {"z0_mm": z0, "thickness_mm": thickness,
-                                 "layers": layers or layer_count(thickness, size_mm)}
-        with tempfile.TemporaryDirectory() as d:
-            (face if section is not None else solid_or_surface).exportBrep(str(Path(d) / "part.brep"))
-            payload = (Path(d) / "part.brep").read_bytes()
-        inputs = {"part.brep": payload}
-        tag_tol_mm = 1e-3 * size_mm
+        settings, inputs, payload, volume, tag_tol_mm = _gmsh_inputs(solid_or_surface, size_mm, elements_per_circle,
+                                                                     sweep, layers)
     else:
-        if is_cad:
-            v, f = tessellate_solid(solid_or_surface, tolerance_mm=min(0.01, size_mm / 50))
-        else:
-            v, f = (np.asarray(a) for a in solid_or_surface)
-        volume = _surface_volume(v, f)
-        diag = float(np.linalg.norm(np.ptp(v, axis=0)))
-        settings = {"backend": backend, "edge_length_fac": size_mm / diag, "epsilon": epsilon}
-        payload = np.ascontiguousarray(v, dtype=np.float64).tobytes() + np.ascontiguousarray(f, dtype=np.int64).tobytes()
-        buf = _npz_bytes(vertices=v, faces=f)
-        inputs = {"surface.npz": buf}
-        tag_tol_mm = 2.0 * epsilon * diag
+        settings, inputs, payload, volume, tag_tol_mm = _pytetwild_inputs(solid_or_surface, size_mm, epsilon)
     t_geom = time.perf_counter() - t0
 
     estimate = volume / (REGULAR_TET_VOLUME * size_mm**3)
@@ -137,23 +104,8 @@ def mesh_part(
     if hit is not None:
         points, tets = hit
     else:
-        for attempt in range(retries + 1):
-            try:
-                points, tets = _run_worker({**settings, "attempt": attempt}, inputs, timeout_s)
-            except (TimeoutError, RuntimeError) as exc:
-                attempts.append(str(exc))
-                continue
-            if len(tets) > max_tets:
-                attempts.append(f"{len(tets):,} tetrahedra > max_tets={max_tets:,}")
-                continue
-            break
-        else:
-            raise MeshError(
-                f"{backend} failed {len(attempts)} times at {size_mm:.3g} mm ({'; '.join(attempts)}); "
-                "try fewer elements_across_beam, a longer timeout_s or the other backend"
-            )
+        points, tets, attempts = _mesh_with_retries(settings, inputs, timeout_s, max_tets, retries, size_mm)
         cache.store(cache_dir, key, points, tets)
-    t_tet = time.perf_counter() - t1
     info = {
         **settings,
         "elements_across_beam": elements_across_beam,
@@ -163,9 +115,72 @@ def mesh_part(
         "cache_hit": hit is not None,
         "failed_attempts": attempts,
         "geometry_s": t_geom,
-        "tetrahedralize_s": t_tet,
+        "tetrahedralize_s": time.perf_counter() - t1,
     }
     return build_tetmesh(points, tets, interfaces, tag_tol_mm, info)
+
+
+def _check_options(backend: str, elements_across_beam: float, beam_width_mm: float, layers: int,
+                   elements_per_circle: float) -> None:
+    if backend not in BACKENDS:
+        raise MeshError(f"mesh backend {backend!r} is unknown; use one of {', '.join(BACKENDS)}")
+    if not (elements_across_beam > 0 and beam_width_mm > 0):
+        raise MeshError(
+            f"elements_across_beam ({elements_across_beam}) and beam_width_mm ({beam_width_mm}) must be positive"
+        )
+    if layers < 0:
+        raise MeshError(f"layers={layers}: give a positive number of layers, or 0 to derive it from the size")
+    if elements_per_circle < 0 or (elements_per_circle > 0 and backend != "gmsh"):
+        raise MeshError(f"elements_per_circle={elements_per_circle:g}: curvature-based sizing needs backend 'gmsh' "
+                        "and a value >= 0; use 0 for a uniform mesh")
+
+
+def _gmsh_inputs(solid, size_mm: float, per_circle: float, sweep: bool, layers: int):
+    """(settings, worker inputs, cache payload, volume mm^3, tagging tolerance mm) for gmsh."""
+    if not hasattr(solid, "exportBrep"):
+        raise MeshError("the gmsh backend needs a CAD solid; mesh surfaces (STL) with backend='pytetwild'")
+    volume = float(solid.Volume())
+    settings = {"backend": "gmsh", "size_mm": size_mm, "per_circle": per_circle}
+    section = prismatic_section(solid) if sweep else None
+    if section is not None:
+        face, z0, thickness = section
+        settings["swept"] = {"z0_mm": z0, "thickness_mm": thickness, "layers": layers or layer_count(thickness, size_mm)}
+    with tempfile.TemporaryDirectory() as d:
+        (face if section is not None else solid).exportBrep(str(Path(d) / "part.brep"))
+        payload = (Path(d) / "part.brep").read_bytes()
+    return settings, {"part.brep": payload}, payload, volume, 1e-3 * size_mm
+
+
+def _pytetwild_inputs(solid_or_surface, size_mm: float, epsilon: float):
+    """(settings, worker inputs, cache payload, volume mm^3, tagging tolerance mm) for pytetwild."""
+    if hasattr(solid_or_surface, "exportBrep"):
+        v, f = tessellate_solid(solid_or_surface, tolerance_mm=min(0.01, size_mm / 50))
+    else:
+        v, f = (np.asarray(a) for a in solid_or_surface)
+    diag = float(np.linalg.norm(np.ptp(v, axis=0)))
+    settings = {"backend": "pytetwild", "edge_length_fac": size_mm / diag, "epsilon": epsilon}
+    payload = np.ascontiguousarray(v, dtype=np.float64).tobytes() + np.ascontiguousarray(f, dtype=np.int64).tobytes()
+    return settings, {"surface.npz": _npz_bytes(vertices=v, faces=f)}, payload, _surface_volume(v, f), 2.0 * epsilon * diag
+
+
+def _mesh_with_retries(settings: dict, inputs: dict[str, bytes], timeout_s: float, max_tets: int, retries: int,
+                       size_mm: float) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Run the mesher in a child process; a failed, timed-out or oversized attempt is retried."""
+    attempts: list[str] = []
+    for attempt in range(retries + 1):
+        try:
+            points, tets = _run_worker({**settings, "attempt": attempt}, inputs, timeout_s)
+        except (TimeoutError, RuntimeError) as exc:
+            attempts.append(str(exc))
+            continue
+        if len(tets) > max_tets:
+            attempts.append(f"{len(tets):,} tetrahedra > max_tets={max_tets:,}")
+            continue
+        return points, tets, attempts
+    raise MeshError(
+        f"{settings['backend']} failed {len(attempts)} times at {size_mm:.3g} mm ({'; '.join(attempts)}); "
+        "try fewer elements_across_beam, a longer timeout_s or the other backend"
+    )
 
 
 def prismatic_section(solid, rel_tol: float = 1e-6):

@@ -5,13 +5,14 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from seadesign.run.atomic import atomic_write
+from seadesign.run.fingerprint import code_fingerprint
+
 CACHE_ENV = "SEADESIGN_CACHE_DIR"
-FORMAT_VERSION = 1  # bump when the stored arrays or the meshing pipeline change meaning
 
 
 def default_cache_dir() -> Path:
@@ -23,9 +24,9 @@ def default_cache_dir() -> Path:
 
 
 def mesh_key(settings: dict, payload: bytes) -> str:
-    """sha256 of the meshing settings and the geometry bytes (tessellation or BREP)."""
+    """sha256 of the meshing settings, the geometry bytes (tessellation or BREP) and the mesher's code."""
     h = hashlib.sha256()
-    h.update(json.dumps({"format": FORMAT_VERSION, **settings}, sort_keys=True).encode())
+    h.update(json.dumps({"code": code_fingerprint("seadesign.mesh.worker"), **settings}, sort_keys=True).encode())
     h.update(payload)
     return h.hexdigest()
 
@@ -48,10 +49,9 @@ def load(cache_dir: Path, key: str) -> tuple[np.ndarray, np.ndarray] | None:
 
 def store(cache_dir: Path, key: str, points: np.ndarray, tets: np.ndarray) -> Path:
     """Write atomically (temporary file + rename) so parallel runs never see half a file."""
-    path = _path(cache_dir, key)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-    with os.fdopen(fd, "wb") as f:
-        np.savez(f, points=points, tets=tets)
-    os.replace(tmp, path)
-    return path
+
+    def write(tmp: Path) -> None:
+        with tmp.open("wb") as f:
+            np.savez(f, points=points, tets=tets)
+
+    return atomic_write(_path(cache_dir, key), write)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from seadesign.errors import MeshError
-from seadesign.part import Hole, Interfaces
+from seadesign.design.interfaces import Hole, Interfaces
 
 
 def _sections(vertices: np.ndarray, faces: np.ndarray, fractions: tuple[float, ...]):

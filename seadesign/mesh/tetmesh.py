@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from seadesign.errors import MeshError
-from seadesign.part import Interfaces
+from seadesign.design.interfaces import Interfaces
 
 
 @dataclass(frozen=True)

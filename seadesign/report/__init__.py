@@ -10,13 +10,16 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from seadesign.cache import Cache, digest
-from seadesign.handoff import write_spring
-from seadesign.rank import Choice
+from seadesign.run.atomic import atomic_write
+from seadesign.run.cache import Cache, digest
+from seadesign.run.fingerprint import code_fingerprint
+from seadesign.design.spring import write_spring
+from seadesign.sweep.rank import Choice
 from seadesign.report.document import write_html, write_markdown
-from seadesign.report.handoff import spring_document
-from seadesign.stages import SolverSettings, fea_key, geometry_key
-from seadesign.study import Study
+from seadesign.sweep.handoff import spring_document
+from seadesign.sweep.stages import SolverSettings, fea_key, geometry_key
+from seadesign.design.space import axis_label
+from seadesign.design.study import Study
 
 log = logging.getLogger(__name__)
 
@@ -28,12 +31,9 @@ def write_tables(t: pd.DataFrame, settings: dict, folder: Path) -> list[Path]:
     table = table.replace_schema_metadata({**(table.schema.metadata or {}),
                                            b"seadesign.settings": json.dumps(settings, default=str).encode()})
     paths = [folder / "results.parquet", folder / "results.csv", folder / "settings.json"]
-    tmp = paths[0].with_suffix(".tmp.parquet")
-    pq.write_table(table, tmp)
-    tmp.replace(paths[0])
-    t.drop(columns=["traceback"], errors="ignore").to_csv(paths[1].with_suffix(".tmp.csv"), index=False)
-    paths[1].with_suffix(".tmp.csv").replace(paths[1])
-    paths[2].write_text(json.dumps(settings, indent=2, sort_keys=True, default=str) + "\n")
+    atomic_write(paths[0], lambda tmp: pq.write_table(table, tmp))
+    atomic_write(paths[1], lambda tmp: t.drop(columns=["traceback"], errors="ignore").to_csv(tmp, index=False))
+    atomic_write(paths[2], lambda tmp: tmp.write_text(json.dumps(settings, indent=2, sort_keys=True, default=str) + "\n"))
     return paths
 
 
@@ -56,32 +56,33 @@ def export_cad(study: Study, rows: pd.DataFrame, folder: Path, tolerance_mm: flo
     """STL + STEP of the given candidates; files whose geometry key is unchanged are kept."""
     out = []
     for _, r in rows.iterrows():
-        params = study.params(int(r["beam_count"]), float(r["beam_thickness_mm"]))
-        stem = f"{params.beam_count}beams_{params.beam_thickness_mm:g}mm"
-        files = [folder / f"{stem}.stl", folder / f"{stem}.step"]
-        key = digest(geometry_key(study, params), tolerance_mm)
+        candidate = study.candidate_of_row(r)
+        files = [folder / f"{candidate.stem}.stl", folder / f"{candidate.stem}.step"]
+        key = digest(geometry_key(study, candidate), tolerance_mm, code_fingerprint("seadesign.design.export"))
         if not up_to_date(files, key):
-            from seadesign.candidates import check_candidate  # CadQuery: only when a file is (re)written
-            from seadesign.export import export_candidate
+            from seadesign.design.export import export_candidate  # CadQuery: only when a file is (re)written
 
-            export_candidate(check_candidate(study, params), folder, tolerance_mm)
+            export_candidate(candidate, study.check(candidate)[1], folder, tolerance_mm)
             stamp(files, key)
         out += files
     return out
 
 
-def write_plots(t: pd.DataFrame, choice: Choice, folder: Path) -> dict[str, Path]:
-    """The sweep's figures by caption; unchanged results keep their PNGs."""
+def write_plots(study: Study, t: pd.DataFrame, choice: Choice, folder: Path) -> dict[str, Path]:
+    """The sweep's figures by caption, over the study's design axes; unchanged results keep their PNGs."""
     from seadesign.report.plots import fig_k, fig_pareto, fig_reaction_displacement
 
+    axes = [a.key for a in study.axes]
+    thesis = axes[:2] == ["beam_count", "beam_thickness_mm"]
     figures = {
-        "Reaction force and displacement vs beam count (thesis fig. 5.3 analogue)":
-            (fig_reaction_displacement, folder / "reaction_displacement.png"),
-        "k vs beam count": (fig_k, folder / "k_vs_beams.png"),
+        f"Reaction force and displacement vs {axis_label(axes[0])}" + (" (thesis fig. 5.3 analogue)" if thesis else ""):
+            (lambda table, path: fig_reaction_displacement(table, axes, path), folder / "reaction_displacement.png"),
+        f"k vs {axis_label(axes[0])}": (lambda table, path: fig_k(table, axes, path), folder / f"k_vs_{axes[0]}.png"),
         "Pareto front": (lambda table, path: fig_pareto(table, choice.index, path), folder / "pareto.png"),
     }
     numbers = t.drop(columns=["elapsed_s", "traceback"], errors="ignore")
-    key = digest("plots", numbers[sorted(numbers.columns)].to_json(), choice.index)
+    key = digest("plots", numbers[sorted(numbers.columns)].to_json(), choice.index, axes,
+                 code_fingerprint("seadesign.report.plots"))
     paths = [path for _, path in figures.values()]
     if not up_to_date(paths, key):
         for draw, path in figures.values():
@@ -96,14 +97,13 @@ def write_renders(study: Study, row: pd.Series, folder: Path, solver: SolverSett
     cached or off-screen rendering is unavailable); unchanged inputs keep their PNGs."""
     from seadesign.report.renders import render_case
 
-    params = study.params(int(row["beam_count"]), float(row["beam_thickness_mm"]))
-    key_fea = fea_key(study, params, solver)
+    key_fea = fea_key(study, study.candidate_of_row(row), solver)
     out = {}
     for case in ("stall", "impact"):
         torque = float(row[f"{case}_torque_Nm"])
         title = f"{row['candidate']}: {case}, {torque:.3g} Nm"
         path = folder / f"chosen_{case}.png"
-        key = digest("render", key_fea, torque, title)
+        key = digest("render", key_fea, torque, title, code_fingerprint("seadesign.report.renders"))
         if not up_to_date([path], key):
             unit = cache.get("fea", key_fea)
             if unit is None or render_case(unit, case, torque, title, path) is None:
@@ -119,7 +119,7 @@ def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, s
     """Write every output of a ranked sweep; returns paths by kind."""
     folder.mkdir(parents=True, exist_ok=True)
     written: dict[str, list[Path]] = {"tables": write_tables(t, settings, folder)}
-    images = write_plots(t, choice, folder)
+    images = write_plots(study, t, choice, folder)
     cad_rows = t[t["status"] != "invalid"] if export_all else t.iloc[[]]
     if choice.index is not None:
         row = t.loc[choice.index]

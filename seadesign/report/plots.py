@@ -1,4 +1,9 @@
-"""Matplotlib figures of a ranked sweep (PNG): thesis fig. 5.3 analogue, k vs beam count, Pareto front."""
+"""Matplotlib figures of a ranked sweep (PNG): reaction and displacement (the thesis's fig. 5.3
+where beam count and beam thickness are the axes), k, and the Pareto front.
+
+The figures adapt to the study's design axes: the first axis is the x axis, and one series is
+drawn per value of the other axes (per beam thickness in the default study).
+"""
 
 from __future__ import annotations
 
@@ -11,18 +16,25 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from seadesign.rank import ACCURACY, PROTECTION  # noqa: E402
+from seadesign.design.space import axis_label, label  # noqa: E402
+from seadesign.sweep.rank import ACCURACY, PROTECTION  # noqa: E402
 
 
-def _by_thickness(t: pd.DataFrame):
+def _series(t: pd.DataFrame, axes: list[str]):
+    """(legend text, rows sorted by the first axis) per combination of the other axes' values."""
     solved = t[t["status"] == "ok"]
-    for thickness, group in solved.groupby("beam_thickness_mm"):
-        yield thickness, group.sort_values("beam_count")
+    x, others = axes[0], axes[1:]
+    if not others:
+        yield "", solved.sort_values(x)
+        return
+    for values, group in solved.groupby(others if len(others) > 1 else others[0]):
+        values = values if isinstance(values, tuple) else (values,)
+        yield ", ".join(label(k, v) for k, v in zip(others, values)), group.sort_values(x)
 
 
-def _series_with_fit(ax, x: np.ndarray, y: np.ndarray, label: str, log: bool, color) -> None:
+def _series_with_fit(ax, x: np.ndarray, y: np.ndarray, text: str, log: bool, color) -> None:
     """Points and a least-squares line (exponential fit, a line on a log axis, when `log`)."""
-    ax.plot(x, y, "o", color=color, label=label)
+    ax.plot(x, y, "o", color=color, label=text or None)
     if len(x) >= 2:
         xs = np.linspace(x.min(), x.max(), 50)
         if log and np.all(y > 0):
@@ -33,37 +45,45 @@ def _series_with_fit(ax, x: np.ndarray, y: np.ndarray, label: str, log: bool, co
             ax.plot(xs, np.polyval(c, xs), "-", color=color, alpha=0.7)
 
 
-def fig_reaction_displacement(t: pd.DataFrame, path: Path) -> Path:
-    """Thesis fig. 5.3 analogue: impact reaction per hub bolt and stall displacement vs beam count."""
+def _legend(ax, axes: list[str]) -> None:
+    if len(axes) > 1 or ax.get_legend_handles_labels()[0]:
+        ax.legend(title=", ".join(axis_label(k) for k in axes[1:]) or None, fontsize=8)
+
+
+def fig_reaction_displacement(t: pd.DataFrame, axes: list[str], path: Path) -> Path:
+    """Impact reaction per hub bolt and stall displacement vs the first axis (thesis fig. 5.3
+    analogue, with its NASTRAN points, when that axis is the beam count)."""
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
-    for i, (thickness, g) in enumerate(_by_thickness(t)):
-        color = f"C{i}"
-        n = g["beam_count"].to_numpy(float)
-        _series_with_fit(a1, n, g["impact_reaction_per_bolt_N"].to_numpy(float), f"{thickness:g} mm", False, color)
-        _series_with_fit(a2, n, g[ACCURACY].to_numpy(float), f"{thickness:g} mm", True, color)
+    x = axes[0]
+    for i, (text, g) in enumerate(_series(t, axes)):
+        n = g[x].to_numpy(float)
+        _series_with_fit(a1, n, g["impact_reaction_per_bolt_N"].to_numpy(float), text, False, f"C{i}")
+        _series_with_fit(a2, n, g[ACCURACY].to_numpy(float), text, True, f"C{i}")
     thesis = t.dropna(subset=["thesis_reaction_N"])
-    if len(thesis):
-        a1.plot(thesis["beam_count"], thesis["thesis_reaction_N"], "k*", ms=10, label="thesis (NASTRAN)")
-        a2.plot(thesis["beam_count"], thesis["thesis_displacement_mm"], "k*", ms=10, label="thesis (NASTRAN)")
-    a1.set(xlabel="beam count (-)", ylabel="impact reaction per hub bolt (N)", title="Reaction force (impact)")
-    a2.set(xlabel="beam count (-)", ylabel="stall bearing displacement (mm)", title="Displacement (stall)", yscale="log")
+    if len(thesis) and x == "beam_count":
+        a1.plot(thesis[x], thesis["thesis_reaction_N"], "k*", ms=10, label="thesis (NASTRAN)")
+        a2.plot(thesis[x], thesis["thesis_displacement_mm"], "k*", ms=10, label="thesis (NASTRAN)")
+    a1.set(xlabel=axis_label(x), ylabel="impact reaction per hub bolt (N)", title="Reaction force (impact)")
+    a2.set(xlabel=axis_label(x), ylabel="stall bearing displacement (mm)", title="Displacement (stall)", yscale="log")
     for a in (a1, a2):
-        a.legend(title="beam thickness")
+        _legend(a, axes)
         a.grid(alpha=0.3)
-    fig.suptitle("Lines: linear fit (reaction) and exponential fit (displacement) per thickness")
+    fig.suptitle("Lines: linear fit (reaction) and exponential fit (displacement) per series")
     return _save(fig, path)
 
 
-def fig_k(t: pd.DataFrame, path: Path) -> Path:
-    """k vs beam count per thickness, error bars from the P1/P2 estimate, the k range if set."""
+def fig_k(t: pd.DataFrame, axes: list[str], path: Path) -> Path:
+    """k vs the first axis per series, error bars from the discretization-error estimate, the k range if set."""
     fig, ax = plt.subplots(figsize=(6, 4))
-    for i, (thickness, g) in enumerate(_by_thickness(t)):
+    x = axes[0]
+    for i, (text, g) in enumerate(_series(t, axes)):
         k = g["k_Nm_per_rad"].to_numpy(float)
-        ax.errorbar(g["beam_count"], k, yerr=k * g["k_rel_error"].to_numpy(float), fmt="o-", capsize=3,
-                    color=f"C{i}", label=f"{thickness:g} mm")
-    ax.set(xlabel="beam count (-)", ylabel="k (Nm/rad)", yscale="log", title="Torsional stiffness (bars: P1-P2 difference)")
+        ax.errorbar(g[x], k, yerr=k * g["k_rel_error"].to_numpy(float), fmt="o-", capsize=3, color=f"C{i}",
+                    label=text or None)
+    ax.set(xlabel=axis_label(x), ylabel="k (Nm/rad)", yscale="log",
+           title="Torsional stiffness (bars: estimated discretization error)")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(title="beam thickness")
+    _legend(ax, axes)
     return _save(fig, path)
 
 
@@ -77,8 +97,7 @@ def fig_pareto(t: pd.DataFrame, chosen: int | None, path: Path) -> Path:
     front = pool[pool["pareto"]].sort_values(ACCURACY)
     ax.plot(front[ACCURACY], front[PROTECTION], "-", color="C0", alpha=0.6, label="Pareto front")
     for _, r in solved.iterrows():
-        ax.annotate(f"{r['beam_count']}/{r['beam_thickness_mm']:g}", (r[ACCURACY], r[PROTECTION]), fontsize=7,
-                    xytext=(3, 3), textcoords="offset points")
+        ax.annotate(r["candidate"], (r[ACCURACY], r[PROTECTION]), fontsize=6, xytext=(3, 3), textcoords="offset points")
     if chosen is not None:
         c = t.loc[chosen]
         ax.plot(c[ACCURACY], c[PROTECTION], "r*", ms=16, label=f"chosen: {c['candidate']}")

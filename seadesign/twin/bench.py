@@ -20,7 +20,7 @@ import pandas as pd
 from seadesign import __version__
 from seadesign.effects import EffectChain
 from seadesign.errors import ConfigError
-from seadesign.handoff import load_spring
+from seadesign.design.spring import load_spring
 from seadesign.twin.config import bench_effects
 
 PROFILES = ("sine", "ramp")

@@ -31,12 +31,13 @@ from seadesign.effects import (
     ThermalSoftening,
     Viscoelastic,
 )
-from seadesign.constants import G_M_PER_S2 as G
+from seadesign.constants import G_M_PER_S2
 from seadesign.errors import ConfigError
 
 #: Coulomb friction of the gearbox in the servo's effort (Nm): the thesis's servo reports torque
 #: before it reaches the horn; 0.3 Nm is our estimate (DOMAIN.md), declared by the loop's robot model.
 GEAR_COULOMB_NM = 0.3
+
 
 @dataclass(frozen=True)
 class KneeConfig:
@@ -97,7 +98,7 @@ class KneeConfig:
 
     @property
     def gravity_amplitude_Nm(self) -> float:
-        return self.lower_leg_mass_kg * G * self.lower_leg_com_fraction * self.lower_leg_m
+        return self.lower_leg_mass_kg * G_M_PER_S2 * self.lower_leg_com_fraction * self.lower_leg_m
 
     def as_dict(self) -> dict[str, Any]:
         return {**asdict(self), "torque_limit_used_Nm": self.torque_limit,
@@ -121,7 +122,7 @@ def knee_effects(cfg: KneeConfig, ground: bool = False) -> EffectChain:
         ThermalSoftening("thermal_softening", enabled=False),
         GravityLoad("gravity", amplitude_Nm=cfg.gravity_amplitude_Nm, angle_offset_rad=-cfg.hip_flexion_rad),
         Friction("friction", coulomb_Nm=0.03, viscous_Nm_s_per_rad=0.15),
-        StanceLoad("ground_contact", enabled=ground, weight_N=cfg.stance_weight_share * cfg.mass_kg * G,
+        StanceLoad("ground_contact", enabled=ground, weight_N=cfg.stance_weight_share * cfg.mass_kg * G_M_PER_S2,
                    upper_leg_m=cfg.upper_leg_m, lower_leg_m=cfg.lower_leg_m),
         SensorDelay("hall_delay", enabled=False),
         SensorOffset("hall_offset", enabled=False),

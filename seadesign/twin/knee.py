@@ -33,11 +33,11 @@ import numpy as np
 import pandas as pd
 
 from seadesign import __version__
-from seadesign.constants import G_M_PER_S2 as G
+from seadesign.constants import G_M_PER_S2
 from seadesign.data.robot import COMMAND_COLUMNS, IMU_COLUMNS, KNEE_SIGN, PRESSURE_COLUMNS, RECORDING_COLUMNS
 from seadesign.effects import EffectChain, effect_rng
 from seadesign.errors import ConfigError
-from seadesign.handoff import load_spring
+from seadesign.design.spring import load_spring
 from seadesign.twin.config import KneeConfig, knee_effects
 from seadesign.twin.walk import Gait, Trial, knee_targets
 
@@ -281,10 +281,10 @@ class KneeSession:
         cr, sr, cp, sp = np.cos(roll / 2), np.sin(roll / 2), np.cos(pitch / 2), np.sin(pitch / 2)
         quat = np.stack([sr * cp, cr * sp, -sr * sp, cr * cp], axis=-1)
         gyro = np.stack([np.gradient(roll, self.dt, axis=1), np.zeros(shape), np.zeros(shape)], axis=-1)
-        acc = G * np.stack([-np.sin(pitch), np.sin(roll) * np.cos(pitch), np.cos(roll) * np.cos(pitch)], axis=-1)
+        acc = G_M_PER_S2 * np.stack([-np.sin(pitch), np.sin(roll) * np.cos(pitch), np.cos(roll) * np.cos(pitch)], axis=-1)
         imu = np.concatenate([quat, gyro + rng.normal(0, 0.01, gyro.shape), acc + rng.normal(0, 0.05, acc.shape)], -1)
         out = {c: imu[..., i].ravel() for i, c in enumerate(IMU_COLUMNS)}
-        weight = self.config.stance_weight_share * self.config.mass_kg * G if self.ground else 0.0
+        weight = self.config.stance_weight_share * self.config.mass_kg * G_M_PER_S2 if self.ground else 0.0
         for k, side in enumerate("lr"):
             per_cell = weight * self.stance[:, :, k] / 4.0
             cells = per_cell[..., None] * (1.0 + rng.normal(0, 0.1, shape + (4,)))

@@ -9,9 +9,9 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from seadesign.tomlcheck import Table, find_toml, read_toml
+from seadesign.design.tomlcheck import Table, find_toml, read_toml
 
-MATERIALS_DIR = Path(__file__).resolve().parents[1] / "materials"
+MATERIALS_DIR = Path(__file__).resolve().parents[2] / "materials"
 
 _TO_PA = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
 _TO_KG_M3 = {"kg/m^3": 1.0, "kg/m3": 1.0, "g/cc": 1000.0, "g/cm^3": 1000.0, "g/cm3": 1000.0}

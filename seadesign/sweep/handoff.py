@@ -7,8 +7,8 @@ import math
 
 import pandas as pd
 
-from seadesign.handoff import SCHEMA_VERSION
-from seadesign.study import Study
+from seadesign.design.spring import SCHEMA_VERSION
+from seadesign.design.study import Study
 
 EXTRAPOLATION_NOTE = (
     "linear FEA; beyond {limit:g} rad the beams' rotations are no longer small (sin x ~ x within 0.2 %), "
@@ -31,8 +31,8 @@ def load_case_block(row: pd.Series, case: str) -> dict[str, float]:
 
 def spring_document(study: Study, row: pd.Series, inputs_hash: str, versions: dict[str, str],
                     selection: dict) -> dict:
-    """The spring.json content of a chosen, solved candidate (validate with handoff.write_spring)."""
-    params = study.params(int(row["beam_count"]), float(row["beam_thickness_mm"]))
+    """The spring.json content of a chosen, solved candidate (validated by design.spring.write_spring)."""
+    params = study.candidate_of_row(row).params
     a, lc, r = study.actuator, study.load_cases, study.robot
     limit = study.ranking.small_deflection_limit_rad
     return {

@@ -11,6 +11,8 @@ import cadquery as cq
 import numpy as np
 import trimesh
 
+from seadesign.design.candidate import Candidate
+from seadesign.design.geometry import Part
 from seadesign.errors import SeadesignError
 
 
@@ -60,11 +62,11 @@ def write_stl(solid: cq.Shape, path: str | Path, tolerance_mm: float = 0.01) -> 
     return path
 
 
-def export_candidate(c, folder: str | Path, tolerance_mm: float = 0.01) -> list[Path]:
-    """STL + STEP of a checked candidate (`candidates.CheckedPart`), named by its parameters."""
+def export_candidate(candidate: Candidate, part: Part, folder: str | Path, tolerance_mm: float = 0.01) -> list[Path]:
+    """STL + STEP of a candidate's built part, named by the candidate (`Candidate.stem`)."""
     folder = Path(folder)
-    stem = f"{c.params.beam_count}beams_{c.params.beam_thickness_mm:g}mm"
-    return [write_stl(c.part.solid, folder / f"{stem}.stl", tolerance_mm), write_step(c.part.solid, folder / f"{stem}.step")]
+    return [write_stl(part.solid, folder / f"{candidate.stem}.stl", tolerance_mm),
+            write_step(part.solid, folder / f"{candidate.stem}.step")]
 
 
 def write_step(solid: cq.Shape, path: str | Path) -> Path:

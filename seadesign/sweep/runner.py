@@ -3,8 +3,9 @@
 Rows are written as they arrive, one JSON file per candidate under `<out>/rows/`, named by a
 hash of every input of that candidate (atomic write: temp file + rename). A rerun reuses rows
 whose inputs are unchanged (failed ones are retried), so an interrupted sweep resumes where it
-stopped; stages of the
-others come from the content-addressed cache when their own inputs are unchanged.
+stopped; stages of the others come from the content-addressed cache when their own inputs are
+unchanged. Interrupted (Ctrl-C, SIGTERM), the sweep stops its workers at once, removes their
+half-written files and raises `SweepStopped` with the count of saved rows.
 Invalid candidates keep their reasons; a candidate whose mesher or solver fails keeps the
 error and the sweep goes on.
 """
@@ -20,12 +21,15 @@ from pathlib import Path
 
 import pandas as pd
 
-from seadesign.cache import Cache, digest, package_versions
-from seadesign.executors import default_jobs, execute
-from seadesign.params import GeometryParams
-from seadesign.progress import ProgressDisplay
-from seadesign.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key, load_case_columns
-from seadesign.study import Study
+from seadesign.design.candidate import Candidate
+from seadesign.design.study import Study
+from seadesign.run.atomic import atomic_write
+from seadesign.run.cache import Cache, digest, package_versions
+from seadesign.run.executors import default_jobs, execute
+from seadesign.run.interrupt import Interrupted, remove_partial_files
+from seadesign.run.progress import ProgressDisplay
+from seadesign.sweep.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key
+from seadesign.sweep.table import candidate_columns, fea_columns, geometry_columns
 
 
 @dataclass(frozen=True)
@@ -34,10 +38,18 @@ class Job:
 
     index: int
     study: Study
-    params: GeometryParams
+    candidate: Candidate
     settings: SolverSettings
     cache: Cache
     row_key: str
+
+
+class SweepStopped(Interrupted):
+    """A sweep stopped by a signal: how many candidates have saved rows, and where."""
+
+    def __init__(self, signal_name: str, saved: int, total: int, rows_dir: Path) -> None:
+        super().__init__(signal_name)
+        self.saved, self.total, self.rows_dir = saved, total, rows_dir
 
 
 @dataclass
@@ -50,21 +62,16 @@ class SweepRun:
     wall_s: float = 0.0
 
 
-def candidate_label(params: GeometryParams) -> str:
-    return f"{params.beam_count} beams x {params.beam_thickness_mm:g} mm"
-
-
-def row_key(study: Study, params: GeometryParams, settings: SolverSettings) -> str:
-    """Hash of every input of one candidate's row (geometry, mesh, material, loads, solver, versions)."""
-    return digest("row", fea_key(study, params, settings), geometry_key(study, params), study.load_cases,
-                  study.bearing_radius_mm, study.material)
+def row_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
+    """Hash of every input of one candidate's row (its axis values, geometry, mesh, material, loads,
+    solver, versions)."""
+    return digest("row", candidate.values, fea_key(study, candidate, settings), geometry_key(study, candidate),
+                  study.load_cases, study.bearing_radius_mm, study.material)
 
 
 def evaluate(job: Job, sink) -> dict:
     """One candidate's row. Never raises for a candidate's own failure: the error is the row."""
-    p = job.params
-    row: dict = {"candidate": candidate_label(p), "beam_count": p.beam_count, "beam_thickness_mm": p.beam_thickness_mm,
-                 "status": "ok", "reason": "", "row_key": job.row_key}
+    row = candidate_columns(job.candidate, job.row_key)
     t0 = time.perf_counter()
 
     def stage(name: str) -> None:
@@ -72,14 +79,13 @@ def evaluate(job: Job, sink) -> dict:
 
     try:
         stage("geometry")
-        geo, checked = check_geometry(job.study, p, job.cache)
-        row["volume_mm3"] = geo.volume_mm3
-        row["mass_g"] = geo.volume_mm3 * 1e-9 * job.study.material.density_kg_per_m3 * 1e3
-        if not geo.valid:
-            row.update(status="invalid", reason="; ".join(geo.reasons))
+        checked, part = check_geometry(job.study, job.candidate, job.cache)
+        row.update(geometry_columns(checked))
+        if not checked.valid:
+            row.update(status="invalid", reason="; ".join(checked.reasons))
         else:
-            unit = fea_response(job.study, p, checked, job.settings, job.cache, stage)
-            row.update(load_case_columns(unit, job.study))
+            unit = fea_response(job.study, checked, part, job.settings, job.cache, stage)
+            row.update(fea_columns(unit, job.study))
     except Exception as exc:  # noqa: BLE001 - a failing candidate is a result, not a crash
         row.update(status="failed", reason=f"{type(exc).__name__}: {exc}".strip(),
                    traceback=traceback.format_exc(limit=4))
@@ -88,13 +94,8 @@ def evaluate(job: Job, sink) -> dict:
 
 
 def write_row(folder: Path, row: dict) -> Path:
-    """Atomically write one row as JSON."""
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{row['row_key']}.json"
-    tmp = path.with_suffix(f".{os.getpid()}.tmp")
-    tmp.write_text(json.dumps(row))  # key order kept: the same columns cold and warm
-    tmp.replace(path)
-    return path
+    """Atomically write one row as JSON (key order kept: the same columns cold and warm)."""
+    return atomic_write(folder / f"{row['row_key']}.json", lambda tmp: tmp.write_text(json.dumps(row)))
 
 
 def read_row(folder: Path, key: str) -> dict | None:
@@ -105,12 +106,8 @@ def read_row(folder: Path, key: str) -> dict | None:
 
 
 def write_table_atomic(df: pd.DataFrame, path: Path) -> None:
-    tmp = path.with_suffix(".tmp" + path.suffix)
-    if path.suffix == ".parquet":
-        df.to_parquet(tmp, index=False)
-    else:
-        df.to_csv(tmp, index=False)
-    tmp.replace(path)
+    """A table as CSV, atomically."""
+    atomic_write(path, lambda tmp: df.to_csv(tmp, index=False))
 
 
 def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverSettings(), cache: Cache = Cache(),
@@ -121,7 +118,7 @@ def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverS
     t0 = time.perf_counter()
     rows_dir = Path(out_dir) / "rows"
     candidates = study.candidates()
-    keys = [row_key(study, p, settings) for p in candidates]
+    keys = [row_key(study, c, settings) for c in candidates]
     rows: dict[int, dict] = {}
     for i, key in enumerate(keys):
         stored = read_row(rows_dir, key)
@@ -129,15 +126,25 @@ def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverS
             rows[i] = stored
     reused = sorted(rows)
     todo = [Job(i, study, candidates[i], settings, cache, keys[i]) for i in range(len(candidates)) if i not in rows]
-    display = ProgressDisplay(len(candidates), len(reused), {j.index: candidate_label(j.params) for j in todo}, quiet)
+    display = ProgressDisplay(len(candidates), len(reused), {j.index: j.candidate.name for j in todo}, quiet)
     partial_csv = Path(out_dir) / "results.partial.csv"
-    for job, row in execute(evaluate, todo, executor, jobs or default_jobs(), scheduler, display.stage, display.tick):
-        write_row(rows_dir, row)
-        rows[job.index] = row
-        display.finished(job.index, row["status"])
-        write_table_atomic(pd.DataFrame([rows[i] for i in sorted(rows)]), partial_csv)
-        if on_row is not None:
-            on_row(row)
+    killed: list[int] = []
+    stream = execute(evaluate, todo, executor, jobs or default_jobs(), scheduler, display.stage, display.tick, killed)
+    try:
+        for job, row in stream:
+            write_row(rows_dir, row)
+            rows[job.index] = row
+            display.finished(job.index, row["status"])
+            write_table_atomic(pd.DataFrame([rows[i] for i in sorted(rows)]), partial_csv)
+            if on_row is not None:
+                on_row(row)
+    except KeyboardInterrupt as exc:
+        stream.close()  # cancels what is pending and kills the workers
+        remove_partial_files([rows_dir, Path(cache.root)], killed + [os.getpid()])
+        display.close()
+        raise SweepStopped(getattr(exc, "signal", "SIGINT"), len(rows), len(candidates), rows_dir) from None
+    finally:
+        stream.close()
     display.close()
     partial_csv.unlink(missing_ok=True)
     table = pd.DataFrame([rows[i] for i in range(len(candidates))])

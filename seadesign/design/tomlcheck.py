@@ -39,16 +39,19 @@ def find_toml(name_or_path: str | Path, folder: Path, kind: str, kinds: str) -> 
 class Table:
     """A TOML table read key by key; `done()` rejects keys nobody asked for."""
 
-    def __init__(self, data: Any, file: Path | str, where: str = "") -> None:
+    def __init__(self, data: Any, file: Path | str, where: str = "", origins: dict[str, str] | None = None) -> None:
         self.file = str(file)
         self.where = where
+        self.origins = origins or {}  # dotted path -> the name to report (a value merged in from elsewhere)
         if not isinstance(data, dict):
             raise self.error(where or "(top level)", f"must be a table, got {type(data).__name__}")
         self.data = data
         self.seen: set[str] = set()
 
     def key(self, name: str) -> str:
-        return f"{self.where}.{name}" if self.where else name
+        """The dotted name of `name` in the file (where a merged-in value came from, if it did)."""
+        path = f"{self.where}.{name}" if self.where else name
+        return self.origins.get(path, path)
 
     def error(self, key: str, problem: str) -> ConfigError:
         return ConfigError(f"{self.file}: {key} {problem}")
@@ -78,10 +81,13 @@ class Table:
                 raise self.error(self.key(name), f"must be {word} {bound:g} (got {value:g})")
         return value
 
-    def integer(self, name: str, default: Any = None, *, ge: int | None = None, le: int | None = None) -> int:
+    def integer(self, name: str, default: Any = None, *, gt: int | None = None, ge: int | None = None,
+                le: int | None = None) -> int:
         value = self._get(name, _REQUIRED if default is None else default)
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.error(self.key(name), f"must be an integer, got {value!r}")
+        if gt is not None and not value > gt:
+            raise self.error(self.key(name), f"must be > {gt} (got {value})")
         if ge is not None and value < ge:
             raise self.error(self.key(name), f"must be >= {ge} (got {value})")
         if le is not None and value > le:
@@ -122,7 +128,8 @@ class Table:
         value = self._get(name, None if optional else _REQUIRED)
         if value is None:
             return None
-        return Table(value, self.file, self.key(name))
+        path = f"{self.where}.{name}" if self.where else name
+        return Table(value, self.file, path, self.origins)
 
     def raw(self, name: str, default: Any = None) -> Any:
         return self._get(name, default)

@@ -2,12 +2,15 @@
 
 Every executor takes a task function `fn(task, sink)` and yields `(task, result)` as results
 arrive. `sink.put((task_id, stage))` reports the stage a task has started; each executor carries
-it back to `on_stage` (a callback, a process queue, or a Dask distributed Queue).
+it back to `on_stage` (a callback, a process queue, or a Dask distributed Queue). Closing the
+generator early (the caller was interrupted) stops the work at once: pending tasks are
+cancelled and local worker processes killed, their pids added to `killed`.
 """
 
 from __future__ import annotations
 
 import contextlib
+import logging
 import multiprocessing as mp
 import os
 import queue
@@ -16,9 +19,13 @@ import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any, Callable, Iterator
 
-from seadesign.errors import SeadesignError
+import psutil
 
-POLL_S = 0.5  # how often stage messages are drained while waiting for results
+from seadesign.errors import SeadesignError
+from seadesign.run.interrupt import ignore_sigint, kill_trees
+
+POLL_S = 0.25  # how often stage messages are drained while waiting for results
+EXECUTORS = ("local", "dask", "serial")
 
 
 class ExecutorError(SeadesignError):
@@ -36,7 +43,7 @@ class _CallbackSink:
 
 
 def run_serial(fn, tasks: list, on_stage: Callable[[Any, str], None], on_tick: Callable[[], None]) -> Iterator:
-    """Tasks one after another in this process (jobs=1; exceptions propagate as raised)."""
+    """Tasks one after another in this process (exceptions propagate as raised)."""
     sink = _CallbackSink(on_stage)
     for task in tasks:
         yield task, fn(task, sink)
@@ -44,24 +51,35 @@ def run_serial(fn, tasks: list, on_stage: Callable[[Any, str], None], on_tick: C
 
 
 def run_processes(fn, tasks: list, jobs: int, on_stage: Callable[[Any, str], None],
-                  on_tick: Callable[[], None]) -> Iterator:
-    """Tasks in a pool of `jobs` fresh ("spawn") processes; stage messages through a managed queue."""
+                  on_tick: Callable[[], None], killed: list[int]) -> Iterator:
+    """Tasks in a pool of `jobs` fresh ("spawn") processes; stage messages through a managed queue.
+
+    When the caller stops (Ctrl-C, SIGTERM, an error), pending tasks are cancelled and the worker
+    processes are killed with everything they started, without waiting for running tasks."""
     ctx = mp.get_context("spawn")
     threads = str(max(1, default_jobs() // jobs))  # solver threads per worker: no oversubscription
-    with _environment(MKL_NUM_THREADS=threads, OMP_NUM_THREADS=threads), ctx.Manager() as manager, \
-            ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+    with _environment(MKL_NUM_THREADS=threads, OMP_NUM_THREADS=threads):
+        manager = ctx.Manager()
+        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=ignore_sigint)
+    finished = False
+    try:
         sink = manager.Queue()
         pending = {pool.submit(fn, task, sink): task for task in tasks}
-        try:
-            while pending:
-                done, _ = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
-                _drain(sink, on_stage)
-                for fut in done:
-                    yield pending.pop(fut), fut.result()
-                on_tick()
-        finally:
-            for fut in pending:
-                fut.cancel()
+        while pending:
+            done, _ = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
+            _drain(sink, on_stage)
+            for fut in done:
+                yield pending.pop(fut), fut.result()
+            on_tick()
+        finished = True
+    finally:
+        if finished:
+            pool.shutdown()
+            manager.shutdown()
+        else:
+            workers = [p.pid for p in (pool._processes or {}).values()]  # noqa: SLF001 - no public accessor
+            pool.shutdown(wait=False, cancel_futures=True)
+            killed.extend(kill_trees(workers + [manager._process.pid]))  # noqa: SLF001
 
 
 @contextlib.contextmanager
@@ -101,15 +119,18 @@ class _DaskSink:
 
 
 def run_dask(fn, tasks: list, scheduler: str | None, jobs: int, on_stage: Callable[[Any, str], None],
-             on_tick: Callable[[], None]) -> Iterator:
+             on_tick: Callable[[], None], killed: list[int]) -> Iterator:
     """Tasks on a Dask distributed cluster at `scheduler` (host:port), or on a LocalCluster of
     `jobs` single-threaded worker processes when no address is given; stage messages come back
-    through a distributed Queue."""
+    through a distributed Queue. When the caller stops, pending futures are cancelled and a
+    LocalCluster's processes are killed (a remote cluster finishes the tasks it is running)."""
     try:
         from distributed import Client, LocalCluster, Queue
     except ImportError:
         raise ExecutorError("--executor dask needs the 'distributed' package: pip install 'dask[distributed]'") from None
+    logging.getLogger("distributed").setLevel(logging.WARNING)  # the sweep's progress is what users read
     cluster = None
+    before = {p.pid for p in psutil.Process().children()}
     try:
         if scheduler:
             client = Client(scheduler, timeout="10s")
@@ -118,6 +139,8 @@ def run_dask(fn, tasks: list, scheduler: str | None, jobs: int, on_stage: Callab
             client = Client(cluster)
     except OSError as exc:
         raise ExecutorError(f"--scheduler {scheduler}: cannot connect ({exc}); check the address (host:port)") from None
+    futures: dict = {}
+    finished = False
     try:
         sink = _DaskSink(Queue(f"seadesign-stages-{uuid.uuid4().hex}", client=client))
         futures = {client.submit(fn, task, sink, pure=False): task for task in tasks}
@@ -131,10 +154,26 @@ def run_dask(fn, tasks: list, scheduler: str | None, jobs: int, on_stage: Callab
             if pending:
                 time.sleep(POLL_S)
             on_tick()
+        finished = True
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        if finished or cluster is None:
+            if not finished:
+                client.cancel(list(futures), force=True)
+            client.close()
+            if cluster is not None:
+                cluster.close()
+        else:  # a LocalCluster's worker processes are ours: kill them rather than wait for a clean close
+            killed.extend(kill_trees([p.pid for p in psutil.Process().children()
+                                      if p.pid not in before and not _is_resource_tracker(p)]))
+            with contextlib.suppress(Exception):
+                client.close(timeout=0.5)
+
+
+def _is_resource_tracker(p: psutil.Process) -> bool:
+    """multiprocessing's resource tracker (it must outlive the workers to clean up after them)."""
+    with contextlib.suppress(psutil.Error):
+        return any("resource_tracker" in part for part in p.cmdline())
+    return False
 
 
 def default_jobs() -> int:
@@ -143,16 +182,17 @@ def default_jobs() -> int:
 
 
 def execute(fn, tasks: list, executor: str, jobs: int, scheduler: str | None,
-            on_stage: Callable[[Any, str], None], on_tick: Callable[[], None]) -> Iterator:
-    """Dispatch to the chosen executor ("local" or "dask")."""
+            on_stage: Callable[[Any, str], None], on_tick: Callable[[], None], killed: list[int]) -> Iterator:
+    """Dispatch to the chosen executor: "local" (a pool of `jobs` worker processes, at most one per
+    task), "dask", or "serial" (this process: for debugging; a signal waits for the running C call)."""
     if jobs < 1:
         raise ExecutorError(f"--jobs must be >= 1 (got {jobs})")
-    if executor == "dask":
-        return run_dask(fn, tasks, scheduler, jobs, on_stage, on_tick)
-    if executor != "local":
-        raise ExecutorError(f"--executor must be 'local' or 'dask' (got {executor!r})")
-    if scheduler:
+    if executor not in EXECUTORS:
+        raise ExecutorError(f"--executor must be one of {', '.join(EXECUTORS)} (got {executor!r})")
+    if scheduler and executor != "dask":
         raise ExecutorError("--scheduler is only used with --executor dask")
-    if jobs == 1 or len(tasks) <= 1:
+    if executor == "dask":
+        return run_dask(fn, tasks, scheduler, jobs, on_stage, on_tick, killed)
+    if executor == "serial" or not tasks:
         return run_serial(fn, tasks, on_stage, on_tick)
-    return run_processes(fn, tasks, min(jobs, len(tasks)), on_stage, on_tick)
+    return run_processes(fn, tasks, min(jobs, len(tasks)), on_stage, on_tick, killed)

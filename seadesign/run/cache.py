@@ -1,8 +1,9 @@
 """Content-addressed cache of sweep stages (geometry, mesh, unit FEA response).
 
 A key is the SHA-256 of the canonical JSON of everything a stage's output depends on: its
-inputs, the key of the stage before it, and the versions of the packages that compute it.
-Entries are pickles written atomically, so an interrupted write never leaves a bad entry.
+inputs, the key of the stage before it, the fingerprint of the project code that computes it
+(`run/fingerprint.py`) and the versions of the third-party packages that do.
+Entries are pickles written atomically (`atomic.py`), so an interrupted write never leaves a bad entry.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ import pickle
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+from seadesign.run.atomic import atomic_write
 
 DEFAULT_CACHE_DIR = Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
 TRACKED_PACKAGES = ("seadesign", "numpy", "scipy", "cadquery", "gmsh", "pytetwild", "mkl")
@@ -69,15 +72,10 @@ class Cache:
         try:
             with self.path(stage, key).open("rb") as fh:
                 return pickle.load(fh)
-        except (FileNotFoundError, EOFError, pickle.UnpicklingError):
+        except Exception:  # noqa: BLE001 - missing, truncated, or pickled by other code: recompute
             return None
 
     def put(self, stage: str, key: str, value: Any) -> None:
         if not self.enabled:
             return
-        path = self.path(stage, key)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        with tmp.open("wb") as fh:
-            pickle.dump(value, fh, protocol=pickle.HIGHEST_PROTOCOL)
-        tmp.replace(path)
+        atomic_write(self.path(stage, key), lambda tmp: tmp.write_bytes(pickle.dumps(value, pickle.HIGHEST_PROTOCOL)))

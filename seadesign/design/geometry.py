@@ -5,8 +5,9 @@ by N equally spaced beams of one handedness. Each beam is an "S" of two opposed 
 of centreline radius `arc_radius_mm` and constant width `beam_thickness_mm`: the first arc is
 centred on the hub circle, the second on the ring's inner circle, and they are tangent half
 way, so the ring's inner radius is hub_radius + 2 arc_radius. Beams are clipped to the gap
-between hub and ring. Fillets of `fillet_radius_mm` round the beam roots; bolt holes (with
-optional counterbores), a central bore and optional radial nut slots are cut afterwards.
+between hub and ring. Fillets of exactly `fillet_radius_mm` round every beam-root corner (or the
+part is not built, with the reason: fillets.py); bolt holes (with optional counterbores), a
+central bore and optional radial nut slots are cut afterwards.
 
 Part frame: axis +z through the origin, the part spans z in [0, thickness_mm], the first
 beam's arc centres lie on the ray at `first_beam_angle_deg` from +x.
@@ -18,9 +19,11 @@ import math
 from dataclasses import dataclass
 
 import cadquery as cq
+import numpy as np
 
-from seadesign.params import GeometryParams
-from seadesign.part import Interfaces
+from seadesign.design.fillets import Fillet, fillet_gap
+from seadesign.design.params import GeometryParams
+from seadesign.design.interfaces import Interfaces
 
 
 @dataclass
@@ -33,6 +36,7 @@ class Part:
     profile: cq.Shape | None  # 2D profile before holes, after fillets (a Face when beams join hub and ring)
     raw_profile: cq.Shape | None  # 2D profile before fillets
     errors: list[str]  # construction failures (each is an invalidity reason)
+    fillets: tuple[Fillet, ...] = ()  # the rounded root corners, one per corner
 
     @property
     def interfaces(self) -> Interfaces:
@@ -81,21 +85,6 @@ def beam_face(p: GeometryParams, index: int) -> cq.Face:
     return beam.rotate(cq.Vector(0, 0, 0), cq.Vector(0, 0, 1), angle)
 
 
-class _RootVertices(cq.selectors.Selector):
-    """Vertices on the hub circle or the ring's inner circle: where beams meet the rings."""
-
-    def __init__(self, radii: tuple[float, ...], tol: float) -> None:
-        self.radii, self.tol = radii, tol
-
-    def filter(self, objectList):  # noqa: D102 (CadQuery selector protocol)
-        out = []
-        for v in objectList:
-            r = math.hypot(v.X, v.Y)
-            if any(abs(r - ri) < self.tol for ri in self.radii):
-                out.append(v)
-        return out
-
-
 def build_profile(p: GeometryParams) -> tuple[list[cq.Face], cq.Shape]:
     """The beams and the unfilleted profile (z = 0, no holes): one face, or with no beams
     the hub and ring as two faces."""
@@ -104,23 +93,36 @@ def build_profile(p: GeometryParams) -> tuple[list[cq.Face], cq.Shape]:
     return beams, (_only_face(shape) if beams else shape)
 
 
-def fillet_roots(p: GeometryParams, raw: cq.Face) -> cq.Face:
-    """Round the corners where beams meet the hub and the ring by `fillet_radius_mm`.
+def root_corners(p: GeometryParams, gap: cq.Face) -> list[tuple[str, np.ndarray]]:
+    """The corners of a gap where a beam meets the hub or the ring: (which, xy in mm)."""
+    out = []
+    for v in gap.Vertices():
+        r = math.hypot(v.X, v.Y)
+        for name, radius in (("hub", p.hub_radius_mm), ("ring", p.ring_inner_radius_mm)):
+            if abs(r - radius) < 1e-3:
+                out.append((name, np.array([v.X, v.Y])))
+    return out
+
+
+def fillet_roots(p: GeometryParams, raw: cq.Face) -> tuple[cq.Face, tuple[Fillet, ...]]:
+    """Round every corner where a beam meets the hub or the ring by `fillet_radius_mm`, exactly
+    (see fillets.py; ValueError names a corner that cannot take it).
 
     Each gap between beams is filleted as its own simple face (its root corners are convex
     there), then the profile is rebuilt from the outer wire and the rounded gaps.
     """
     if p.fillet_radius_mm <= 0 or p.beam_count == 0:
-        return raw
-    roots = _RootVertices((p.hub_radius_mm, p.ring_inner_radius_mm), 1e-3)
-    gaps = []
+        return raw, ()
+    gaps, made = [], []
     for wire in raw.innerWires():
-        rounded = cq.Sketch().face(cq.Face.makeFromWires(wire)).vertices(roots).fillet(p.fillet_radius_mm)
-        gaps.append(_only_face(rounded._faces).outerWire())
+        gap = cq.Face.makeFromWires(wire)
+        rounded, fillets = fillet_gap(gap, root_corners(p, gap), p.fillet_radius_mm)
+        gaps.append(rounded.outerWire())
+        made += fillets
     profile = cq.Face.makeFromWires(raw.outerWire(), gaps)
     if not profile.isValid():
         raise ValueError("the filleted profile is not a valid face")
-    return profile
+    return profile, tuple(made)
 
 
 def _cutters(p: GeometryParams) -> list[cq.Solid]:
@@ -160,10 +162,9 @@ def build_part(p: GeometryParams) -> Part:
     except Exception as exc:
         return Part(p, None, [], None, None, [f"the beams and rings do not fuse into one profile ({exc})"])
     try:
-        profile = fillet_roots(p, raw)
+        profile, fillets = fillet_roots(p, raw)
     except Exception as exc:
-        return Part(p, None, beams, None, raw, [f"the {p.fillet_radius_mm:g} mm beam-root fillets cannot be made "
-                                                f"(corners too close or too sharp: {exc})"])
+        return Part(p, None, beams, None, raw, [f"beam-root fillets cannot be made: {exc}"])
     try:
         pieces = [cq.Solid.extrudeLinear(f, cq.Vector(0, 0, p.thickness_mm)) for f in profile.Faces()]
         solid = pieces[0] if len(pieces) == 1 else cq.Compound.makeCompound(pieces)
@@ -171,6 +172,6 @@ def build_part(p: GeometryParams) -> Part:
         if cutters:
             solid = solid.cut(*cutters).clean()
     except Exception as exc:
-        return Part(p, None, beams, profile, raw, [f"cutting holes, bore or slots failed ({exc})"])
+        return Part(p, None, beams, profile, raw, [f"cutting holes, bore or slots failed ({exc})"], fillets)
     solids = solid.Solids()
-    return Part(p, solids[0] if len(solids) == 1 else solid, beams, profile, raw, [])
+    return Part(p, solids[0] if len(solids) == 1 else solid, beams, profile, raw, [], fillets)

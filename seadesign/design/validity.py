@@ -13,8 +13,8 @@ import cadquery as cq
 import numpy as np
 from shapely.geometry import Point, Polygon
 
-from seadesign.geometry import Part
-from seadesign.params import ValidityRules
+from seadesign.design.geometry import Part
+from seadesign.design.params import ValidityRules
 
 
 def _wire_polygon(wire: cq.Wire, step_mm: float = 0.05) -> np.ndarray:
@@ -44,6 +44,11 @@ def check(part: Part, rules: ValidityRules) -> list[str]:
     if clearance < rules.min_clearance_mm:
         word = "touch or overlap" if clearance < 1e-6 else f"are {clearance:.2f} mm apart"
         reasons.append(f"neighbouring beams {word}; the minimum clearance is {rules.min_clearance_mm:g} mm")
+    if part.raw_profile is not None:
+        short = [e.Length() for e in part.raw_profile.Edges() if e.Length() < rules.min_feature_mm]
+        if short:
+            reasons.append(f"degenerate feature: {len(short)} profile edge(s) shorter than {rules.min_feature_mm:g} mm "
+                           f"(shortest {min(short):.3f} mm)")
     if part.errors:
         return reasons
 
@@ -52,11 +57,6 @@ def check(part: Part, rules: ValidityRules) -> list[str]:
         reasons.append(f"the part is {len(solids)} separate solids, not one")
     elif not part.solid.isValid():
         reasons.append("the B-rep is not a valid closed solid (OCC check failed)")
-
-    short = [e.Length() for e in part.raw_profile.Edges() if e.Length() < rules.min_feature_mm]
-    if short:
-        reasons.append(f"degenerate feature: {len(short)} profile edge(s) shorter than {rules.min_feature_mm:g} mm "
-                       f"(shortest {min(short):.3f} mm)")
 
     gaps = _gaps(part) if clearance >= rules.min_clearance_mm else []
     half = rules.min_feature_mm / 2

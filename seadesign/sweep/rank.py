@@ -23,11 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from seadesign.study import Study
+from seadesign.constants import THESIS_FEA_RESULTS
+from seadesign.design.study import Study
 
-# Thesis NASTRAN results (Stelter 2022, fig. 5.3/5.4) for the candidates it reports numerically:
-# (beams, thickness mm) -> (peak reaction force N, stall bearing displacement mm).
-THESIS_RESULTS = {(5, 6.0): (149.3, 0.6521), (9, 8.0): (150.3, 0.3532)}
 ACCURACY = "stall_bearing_displacement_mm"
 PROTECTION = "impact_gearbox_torque_Nm"
 
@@ -66,11 +64,16 @@ def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
     t["max_rotation_rad"] = rotations.max(axis=1, skipna=True)
     t["extrapolation"] = t["max_rotation_rad"] > rk.small_deflection_limit_rad
     t["small_deflection_limit_rad"] = rk.small_deflection_limit_rad
-    thesis = [THESIS_RESULTS.get((int(n), float(w)), (math.nan, math.nan))
-              for n, w in zip(t["beam_count"], t["beam_thickness_mm"])]
+    thesis = [_thesis_result(study, row) for _, row in t.iterrows()]
     t["thesis_reaction_N"] = [r for r, _ in thesis]
     t["thesis_displacement_mm"] = [d for _, d in thesis]
     return t
+
+
+def _thesis_result(study: Study, row: pd.Series) -> tuple[float, float]:
+    """The thesis's (reaction N, displacement mm) for the row's beam count and thickness, when it reports them."""
+    p = study.candidate_of_row(row).params
+    return THESIS_FEA_RESULTS.get((p.beam_count, p.beam_thickness_mm), (math.nan, math.nan))
 
 
 def constraint_columns(t: pd.DataFrame, study: Study) -> pd.DataFrame:

@@ -1,0 +1,269 @@
+"""Study files (`studies/*.toml`): the design space, fixed geometry, material, load cases,
+robot/actuator data, mesh and ranking settings of one design problem.
+
+`[design_space]` names the axes (any numeric geometry key, see `space.py`), `[geometry]` the fixed
+values; each candidate's merged geometry is checked when the study loads.
+
+Every key is validated (present, typed, in range, no unknown keys); derived quantities such
+as the impact torque are computed here from physical inputs, never typed in.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from seadesign.constants import G_M_PER_S2
+from seadesign.design.candidate import Candidate, check_candidate
+from seadesign.design.materials import Material, load_material
+from seadesign.design.params import ValidityRules, read_geometry
+from seadesign.design.space import Axis, Value, grid, merged, read_axes
+from seadesign.design.tomlcheck import Table, find_toml, read_toml
+from seadesign.errors import ConfigError
+
+if TYPE_CHECKING:
+    from seadesign.design.geometry import Part
+
+STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
+DEFAULT_STUDY = STUDIES_DIR / "wolfgang_knee.toml"
+
+
+@dataclass(frozen=True)
+class LoadCases:
+    """The two load cases as physical inputs (SI)."""
+
+    stall_torque_Nm: float  # servo stall torque, applied on the hub
+    foot_cell_force_N: float  # largest single load-cell reading at impact
+    foot_cell_count: int  # cells per foot; the thesis took max cell x count
+    lower_leg_m: float  # knee to foot lever: the robot's lower leg (study key robot.lower_leg_m)
+    impact_knee_angle_deg: float  # angle between force and lever at impact
+
+    @property
+    def foot_force_N(self) -> float:
+        return self.foot_cell_force_N * self.foot_cell_count
+
+    @property
+    def impact_torque_Nm(self) -> float:
+        """tau = r F sin(theta) (thesis eq. 5.1), applied on the backplate side."""
+        return self.lower_leg_m * self.foot_force_N * math.sin(math.radians(self.impact_knee_angle_deg))
+
+
+@dataclass(frozen=True)
+class Robot:
+    """Robot data for the standing load and the simulator (SI)."""
+
+    mass_kg: float
+    upper_leg_m: float
+    lower_leg_m: float
+    standing_knee_flexion_deg: float  # knee bend when standing
+
+    @property
+    def standing_knee_torque_Nm(self) -> float:
+        """Static knee torque standing on two legs: half the weight acting on the lower leg's
+        horizontal lever, lower_leg sin(flexion / 2) (hip above ankle, both segments tilted
+        by half the flexion)."""
+        return self.mass_kg * G_M_PER_S2 / 2 * self.lower_leg_m * math.sin(math.radians(self.standing_knee_flexion_deg) / 2)
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """Servo data (the stall torque lives in the load cases)."""
+
+    gear_ratio: float
+    no_load_speed_rpm: float
+    backlash_deg: float
+
+
+@dataclass(frozen=True)
+class MeshSettings:
+    elements_across_beam: float  # target tetrahedra across the beam width
+    backend: str  # "pytetwild" or "gmsh"
+    elements_per_circle: float = 0.0  # gmsh: curved surfaces (bolt holes, fillets) get this many elements per turn
+    layers: float = 0.0  # gmsh, prismatic parts: layers through the thickness (0: about one per element size)
+
+    def scaled(self, refinement: float) -> "MeshSettings":
+        """These settings at `refinement` times the density (layers rounded up)."""
+        return MeshSettings(self.elements_across_beam * refinement, self.backend,
+                            self.elements_per_circle * refinement, math.ceil(self.layers * refinement - 1e-9))
+
+    def mesh_part_options(self) -> dict:
+        """Keyword arguments of seadesign.mesh.mesh_part."""
+        return {"elements_across_beam": self.elements_across_beam, "elements_per_circle": self.elements_per_circle,
+                "layers": math.ceil(self.layers - 1e-9), "backend": self.backend}
+
+
+@dataclass(frozen=True)
+class Ranking:
+    """Constraints and objective weights for choosing a candidate."""
+
+    safety_factor: float  # peak stress must stay below yield / safety_factor
+    max_standing_deflection_deg: float  # knee deflection under the standing load
+    k_min_Nm_per_rad: float | None
+    k_max_Nm_per_rad: float | None
+    small_deflection_limit_rad: float  # beyond it a linear solution is an extrapolation
+    impact_speed_m_per_s: float  # foot speed at touchdown
+    knee_inertia_kg_m2: float  # inertia of the link behind the spring, about the knee
+    weight_accuracy: float
+    weight_protection: float
+
+
+@dataclass(frozen=True)
+class Study:
+    name: str
+    description: str
+    path: Path
+    material: Material
+    axes: tuple[Axis, ...]  # the design space; every other geometry key is fixed
+    fixed: dict  # the raw [geometry] table (nested, mm / deg), without the axes
+    validity: ValidityRules
+    load_cases: LoadCases
+    robot: Robot
+    actuator: Actuator
+    mesh: MeshSettings
+    ranking: Ranking
+    bearing_radius_mm: float  # where the stall displacement is read (thesis eq. 5.3)
+
+    def candidates(self) -> list[Candidate]:
+        """Every combination of the axes' values, the first axis varying fastest."""
+        return [self._candidate(values) for values in grid(self.axes)]
+
+    def candidate(self, *values: Value, **by_key: Value) -> Candidate:
+        """The candidate with these axis values, in axis order or by key (dotted keys by `**{}`);
+        a value outside the study's design space is refused, naming the axes."""
+        keys = [a.key for a in self.axes]
+        if len(values) > len(keys) or set(by_key) - set(keys):
+            raise ConfigError(f"study '{self.name}' has the design axes {keys}; got values {list(values)} "
+                              f"and keys {sorted(by_key)}")
+        given = dict(zip(keys, values), **by_key)
+        axes_text = "; ".join(f"{a.key} in {list(a.values)}" for a in self.axes)
+        for axis in self.axes:
+            value = given.get(axis.key)
+            if value is None or value not in axis.values:
+                shown = "(missing)" if value is None else f"{value:g}"
+                raise ConfigError(f"{axis.key} = {shown} is not in study '{self.name}' ({axes_text})")
+            given[axis.key] = axis.values[axis.values.index(value)]  # the axis's own type (int or float)
+        return self._candidate(tuple((k, given[k]) for k in keys))
+
+    def check(self, candidate: Candidate) -> tuple[Candidate, "Part"]:
+        """Build and check a candidate with this study's validity rules and material density."""
+        return check_candidate(candidate, self.validity, self.material.density_kg_per_m3)
+
+    def candidate_of_row(self, row) -> Candidate:
+        """The candidate a results-table row (one column per axis) belongs to."""
+        return self.candidate(**{a.key: type(a.values[0])(row[a.key]) for a in self.axes})
+
+    def _candidate(self, values: tuple[tuple[str, Value], ...]) -> Candidate:
+        origins = {f"geometry.{key}": f"design_space.{key}[{axis.values.index(v)}]"
+                   for axis, (key, v) in zip(self.axes, values)}
+        params = read_geometry(Table(merged(self.fixed, values), self.path, "geometry", origins))
+        if self.bearing_radius_mm > params.hub_radius_mm + 1e-9:
+            raise ConfigError(f"{self.path}: bearing_radius_mm must not exceed geometry.hub_radius_mm "
+                              "(it is read on the hub)")
+        return Candidate(values, params)
+
+
+def _impact_lever(lc: Table, robot: Robot) -> float:
+    """The impact lever is the robot's lower leg. Older study files also gave it as
+    load_cases.lower_leg_m: still read, with a deprecation message, and refused when it differs."""
+    old = lc.number("lower_leg_m", required=False, gt=0)
+    if old is not None:
+        if old != robot.lower_leg_m:
+            raise lc.error(lc.key("lower_leg_m"), f"({old:g} m) differs from robot.lower_leg_m ({robot.lower_leg_m:g} m); "
+                                                  "the impact lever is the lower leg: remove load_cases.lower_leg_m")
+        warnings.warn(f"{lc.file}: load_cases.lower_leg_m is deprecated (it repeats robot.lower_leg_m, which the "
+                      "impact torque now uses); remove it from the study file", FutureWarning, stacklevel=3)
+    return robot.lower_leg_m
+
+
+def _validity(top: Table) -> ValidityRules:
+    v = top.table("validity")
+    rules = ValidityRules(v.number("min_clearance_mm", gt=0), v.number("min_feature_mm", gt=0),
+                          v.number("min_wall_mm", gt=0))
+    v.done()
+    return rules
+
+
+def _robot(top: Table) -> Robot:
+    r = top.table("robot")
+    robot = Robot(r.number("mass_kg", gt=0), r.number("upper_leg_m", gt=0), r.number("lower_leg_m", gt=0),
+                  r.number("standing_knee_flexion_deg", ge=0, lt=180))
+    r.done()
+    return robot
+
+
+def _load_cases(top: Table, robot: Robot) -> LoadCases:
+    lc = top.table("load_cases")
+    load_cases = LoadCases(
+        stall_torque_Nm=lc.number("stall_torque_Nm", gt=0),
+        foot_cell_force_N=lc.number("foot_cell_force_N", gt=0),
+        foot_cell_count=lc.integer("foot_cell_count", ge=1),
+        lower_leg_m=_impact_lever(lc, robot),
+        impact_knee_angle_deg=lc.number("impact_knee_angle_deg", gt=0, lt=180),
+    )
+    lc.done()
+    return load_cases
+
+
+def _actuator(top: Table) -> Actuator:
+    a = top.table("actuator")
+    actuator = Actuator(a.number("gear_ratio", gt=0), a.number("no_load_speed_rpm", gt=0), a.number("backlash_deg", ge=0))
+    a.done()
+    return actuator
+
+
+def _mesh(top: Table) -> MeshSettings:
+    m = top.table("mesh")
+    mesh = MeshSettings(m.number("elements_across_beam", gt=0), m.string("backend", "gmsh"),
+                        m.number("elements_per_circle", 0.0, ge=0), m.number("layers", 0.0, ge=0))
+    m.done()
+    if mesh.backend not in ("pytetwild", "gmsh"):
+        raise m.error(m.key("backend"), f"must be 'pytetwild' or 'gmsh', got '{mesh.backend}'")
+    if mesh.backend != "gmsh" and mesh.elements_per_circle > 0:
+        raise m.error(m.key("elements_per_circle"), "curvature-based sizing needs backend = 'gmsh'; set it to 0 "
+                                                    "for pytetwild")
+    return mesh
+
+
+def _ranking(top: Table) -> Ranking:
+    rk = top.table("ranking")
+    ranking = Ranking(
+        safety_factor=rk.number("safety_factor", ge=1),
+        max_standing_deflection_deg=rk.number("max_standing_deflection_deg", gt=0),
+        k_min_Nm_per_rad=rk.number("k_min_Nm_per_rad", gt=0, required=False),
+        k_max_Nm_per_rad=rk.number("k_max_Nm_per_rad", gt=0, required=False),
+        small_deflection_limit_rad=rk.number("small_deflection_limit_rad", gt=0),
+        impact_speed_m_per_s=rk.number("impact_speed_m_per_s", gt=0),
+        knee_inertia_kg_m2=rk.number("knee_inertia_kg_m2", gt=0),
+        weight_accuracy=rk.number("weight_accuracy", ge=0),
+        weight_protection=rk.number("weight_protection", ge=0),
+    )
+    rk.done()
+    if ranking.weight_accuracy + ranking.weight_protection <= 0:
+        raise ConfigError(f"{top.file}: ranking.weight_accuracy + ranking.weight_protection must be > 0")
+    return ranking
+
+
+def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
+    """Load and validate a study by path or by name (a file stem in `studies/`)."""
+    path = find_toml(path, STUDIES_DIR, "study", "studies")
+    top = Table(read_toml(path), path)
+    name = top.string("name")
+    description = top.string("description")
+    try:
+        material = load_material(top.string("material"))
+    except ConfigError as exc:
+        raise top.error("material", f"cannot be loaded: {exc}") from None
+    bearing_radius_mm = top.number("bearing_radius_mm", gt=0)
+    fixed = top.raw("geometry", None)
+    if not isinstance(fixed, dict):
+        raise top.error("geometry", "is missing or not a table; add [geometry] with the fixed dimensions (mm, deg)")
+    axes = read_axes(top.table("design_space"), fixed)
+    robot = _robot(top)
+    study = Study(name, description, path, material, axes, fixed, _validity(top), _load_cases(top, robot), robot,
+                  _actuator(top), _mesh(top), _ranking(top), bearing_radius_mm)
+    top.done()
+    study.candidates()  # every combination is checked now, so a bad value is named before any work starts
+    return study

@@ -1,0 +1,154 @@
+"""The per-candidate stages of a sweep: geometry -> validity -> mesh -> unit FEA -> load cases.
+
+Each stage takes and returns typed objects (`Candidate`, `TetMesh`, `UnitResponse`). Each
+expensive stage is cached under a key made of its inputs and the previous stage's key, so
+changing one input recomputes only the stages that depend on it. The FEA is solved once for
+1 Nm of hub torque (ring held); both load cases are that response scaled by the rules of
+`fea.results`, since the model is linear (see seadesign/fea/torsion.py). The results table's
+columns are made from these objects in `sweep/table.py`.
+
+Meshing is `seadesign.mesh.mesh_part`, the solve `seadesign.fea.loadcases.analyse` at 1 Nm per
+load case; a second P2 solve on a mesh COARSENING times coarser gives the discretization-error
+estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest order observed in
+benchmarks/fea_convergence.py).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
+
+from seadesign.design.candidate import Candidate
+from seadesign.design.study import Study
+from seadesign.run.cache import Cache, digest, package_versions
+from seadesign.run.fingerprint import code_fingerprint
+
+if TYPE_CHECKING:
+    from seadesign.design.geometry import Part
+    from seadesign.fea.results import LinearResults
+
+Progress = Callable[[str], None]  # receives the name of the stage that starts
+COARSENING = 1.5  # edge-length ratio of the error-estimate mesh to the result mesh
+CONVERGENCE_ORDER = 1.1  # smallest order of k observed in benchmarks/fea_convergence.py (1.10-1.89)
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """Numerical settings that change results (part of every FEA cache key)."""
+
+    element_order: int = 2  # P2 tetrahedra
+    linear_solver: str = "pardiso"  # "pardiso" or "scipy"
+
+
+@dataclass(frozen=True)
+class UnitResponse:
+    """The FEA of one candidate at 1 Nm in each load case (scale with `results.at`), the error
+    estimate's coarse k, how the mesh and solve went, and vertex fields for renders."""
+
+    results: LinearResults  # both load cases at 1 Nm
+    k_coarse_Nm_per_rad: float  # k on a COARSENING times coarser mesh (error estimate of k)
+    time_fea_total_s: float
+    time_error_estimate_s: float
+    mesh_mean_aspect_ratio: float
+    mesh_target_edge_mm: float
+    mesh_tetrahedralize_s: float
+    points_mm: np.ndarray  # (n, 3) mesh vertices
+    tets: np.ndarray  # (m, 4)
+    vertex_displacement_m: dict  # case -> (n, 3) displacement in m per Nm
+    vertex_von_mises_Pa: np.ndarray  # (n,) von Mises in Pa per Nm (same for both cases)
+
+
+def geometry_key(study: Study, candidate: Candidate) -> str:
+    """Inputs of the geometry verdict: the parameters, the rules, the CAD code and kernel."""
+    return digest("geometry", candidate.params, study.validity, code_fingerprint("seadesign.design.candidate"),
+                  package_versions(("cadquery",)))
+
+
+def mesh_key(study: Study, candidate: Candidate) -> str:
+    """Inputs of the mesh (the mesh package keys its own cache by the surface it receives)."""
+    return digest("mesh", geometry_key(study, candidate), study.mesh,
+                  code_fingerprint("seadesign.mesh", "seadesign.mesh.worker"), package_versions(("pytetwild", "gmsh")))
+
+
+def fea_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
+    """Inputs of the unit response: the mesh, the material, the solver settings, and the code of
+    this module with everything it imports (the solver, the mesher, the study's mesh sizing)."""
+    m = study.material
+    return digest("fea", mesh_key(study, candidate), m.youngs_modulus_Pa, m.poisson_ratio,
+                  settings.element_order, settings.linear_solver,
+                  code_fingerprint("seadesign.sweep.stages", "seadesign.mesh.worker"), package_versions())
+
+
+def check_geometry(study: Study, candidate: Candidate, cache: Cache) -> tuple[Candidate, Part | None]:
+    """The checked candidate (verdict and volume cached) and its CAD part when it had to be built."""
+    key = geometry_key(study, candidate)
+    hit = cache.get("geometry", key)
+    if hit is not None:
+        reasons, volume_mm3 = hit
+        return candidate.with_geometry(reasons, volume_mm3, study.material.density_kg_per_m3), None
+    checked, part = study.check(candidate)
+    cache.put("geometry", key, (checked.reasons, checked.volume_mm3))
+    return checked, part
+
+
+def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache, coarsening: float = 1.0):
+    """Tetrahedral mesh (mm) of a built part with named interface boundaries (mesh package,
+    its own content-addressed cache under the sweep cache's root); `coarsening` > 1 makes the
+    elements that many times longer (beam, curvature and layer sizing alike)."""
+    from seadesign.mesh import mesh_part
+
+    return mesh_part(part.solid, part.interfaces, beam_width_mm=candidate.params.beam_thickness_mm,
+                     cache_dir=Path(cache.root) / "mesh", **study.mesh.scaled(1.0 / coarsening).mesh_part_options())
+
+
+def unit_response(mesh, coarse_mesh, study: Study, settings: SolverSettings) -> UnitResponse:
+    """Both load cases at 1 Nm, and k on the coarse mesh for the error estimate."""
+    from seadesign.fea.loadcases import analyse
+    from seadesign.fea.stress import invariants
+    from seadesign.fea.torsion import solve_unit_torsion
+
+    m = study.material
+    t0 = time.perf_counter()
+    a = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, 1.0, 1.0, study.bearing_radius_mm,
+                order=settings.element_order, linear_solver=settings.linear_solver)
+    t1 = time.perf_counter()
+    coarse = solve_unit_torsion(coarse_mesh, m.youngs_modulus_Pa, m.poisson_ratio, order=settings.element_order,
+                                linear_solver=settings.linear_solver)
+    nv = a.unit.emesh.n_vertices
+    return UnitResponse(
+        results=a.results,
+        k_coarse_Nm_per_rad=1.0 / float(coarse.hub_motion[5]),
+        time_fea_total_s=t1 - t0,
+        time_error_estimate_s=time.perf_counter() - t1,
+        mesh_mean_aspect_ratio=mesh.quality.mean_aspect_ratio,
+        mesh_target_edge_mm=mesh.info.get("target_edge_mm", float("nan")),
+        mesh_tetrahedralize_s=mesh.info.get("tetrahedralize_s", float("nan")),
+        points_mm=mesh.points_mm,
+        tets=mesh.tets,
+        vertex_displacement_m={case: a.displacement_m(case)[:nv] for case in ("stall", "impact")},
+        vertex_von_mises_Pa=invariants(a.stress_per_Nm_Pa[:nv])["von_mises"],
+    )
+
+
+def fea_response(study: Study, candidate: Candidate, part: Part | None, settings: SolverSettings, cache: Cache,
+                 progress: Progress) -> UnitResponse:
+    """Unit response via the cache: the part (when not given) and the mesh (cached) are made only
+    when the solve is not cached."""
+    fkey = fea_key(study, candidate, settings)
+    unit = cache.get("fea", fkey)
+    if unit is not None:
+        return unit
+    if part is None:
+        progress("geometry")
+        _, part = study.check(candidate)
+    progress("mesh")
+    mesh = tetrahedralize(study, candidate, part, cache)
+    coarse_mesh = tetrahedralize(study, candidate, part, cache, COARSENING)
+    progress("fea")
+    unit = unit_response(mesh, coarse_mesh, study, settings)
+    cache.put("fea", fkey, unit)
+    return unit

@@ -1,0 +1,51 @@
+"""Typed FEA results: every quantity declares how it scales with the applied torque, and the
+declared rules reproduce a direct solve at another torque."""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+
+import pytest
+from helpers_parts import holed_annulus
+
+import seadesign.fea.results as results_module
+from seadesign.fea.loadcases import analyse
+from seadesign.fea.results import scaled
+from seadesign.mesh import mesh_part
+
+
+def _result_types():
+    return [c for _, c in inspect.getmembers(results_module, inspect.isclass)
+            if dataclasses.is_dataclass(c) and c.__module__ == results_module.__name__]
+
+
+@pytest.mark.parametrize("cls", _result_types(), ids=lambda c: c.__name__)
+def test_every_field_has_a_torque_rule(cls):
+    for f in dataclasses.fields(cls):
+        nested = dataclasses.is_dataclass(f.type) or f.type in {c.__name__ for c in _result_types()}
+        assert nested or "scaling" in f.metadata, f"{cls.__name__}.{f.name} has no torque-scaling rule"
+
+
+def test_a_field_without_a_rule_is_refused():
+    @dataclasses.dataclass(frozen=True)
+    class Forgotten:
+        torque_Nm: float = results_module.linear()
+        new_output_mm: float = 0.0
+
+    with pytest.raises(TypeError, match="new_output_mm has no torque-scaling rule"):
+        scaled(Forgotten(1.0, 2.0), 3.0)
+
+
+def test_scaled_unit_solve_equals_a_direct_solve(tmp_path):
+    """The rules applied to a 1 Nm solve give the numbers of a solve at the load torques (every
+    column but the timings): a quantity with a wrong rule (say a safety factor declared linear) fails."""
+    solid, ifc = holed_annulus()
+    mesh = mesh_part(solid, ifc, elements_across_beam=1, beam_width_mm=3.0, cache_dir=tmp_path)
+    unit = analyse(mesh, 12e6, 0.48, 4e6, 1.0, 1.0, bearing_radius_mm=9.0).results
+    direct = analyse(mesh, 12e6, 0.48, 4e6, 11.7, 27.7, bearing_radius_mm=9.0).results.columns()
+    via_rules = unit.at(11.7, 27.7).columns()
+    assert set(via_rules) == set(direct)
+    for key, value in direct.items():
+        if not key.startswith("time_"):
+            assert via_rules[key] == pytest.approx(value, rel=1e-12, abs=1e-12), key
