@@ -24,6 +24,16 @@ def softening_knee():
     return robot({"cubic_stiffening": {"k3_Nm_per_rad3": K3}}, seed=50)
 
 
+def test_a_schema_2_spring_json_with_the_curve_loads_and_is_the_models_spring(tmp_path, spring_dict):
+    from seadesign.design.spring import load_spring, write_spring
+    from seadesign.effects import SpringCurve
+    from seadesign.loop.sea import model_spring
+
+    path = write_spring({**spring_dict, "schema_version": 2, "torque_curve": curve(0.17)}, tmp_path / "spring.json")
+    spring = model_spring(load_spring(path))
+    assert isinstance(spring, SpringCurve) and spring.curve.end_rotation_rad == pytest.approx(0.17)
+
+
 def test_curve_is_the_spring_and_explains_the_softening(spring_dict, softening_knee):
     linear = explain(robot_loop_data(softening_knee, spring_dict), [], max_steps=1)
     assert linear.found == ["cubic_stiffening"], linear.verdict()
