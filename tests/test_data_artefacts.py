@@ -118,5 +118,20 @@ def test_real_recordings(name, expect):
     assert 140 < rep.sampling["rate_median_hz"] < 170
     if name.startswith("ground"):
         assert k["offset"]["first_rest_rad"] < -0.5 and k["offset"]["first_rest_pressure"] > 10  # sag under load
-    res = clean(df, keep_lifted=not name.startswith("ground"))
+    hanging = not name.startswith("ground")
+    res = clean(df, keep_lifted=hanging, normalise=False)
     assert len(res.table) + sum(res.removed.values()) == len(df)
+    lifted = df[[c for c in df.columns if "_pressure_" in c]].to_numpy().sum(axis=1) < 10.0
+    assert res.removed.get("l_hall_stuck", 0) == int((rep.masks["l"]["stuck"] & (~lifted | hanging)).sum())
+    # what cleaning promises, checked on its output by the detector: nothing stuck, no glitch, step or wrap is
+    # left; a hanging recording's Hall offset at rest is gone, a ground recording's (no unloaded rest) is kept
+    after = detect_artefacts(res.table)
+    for side in "lr":
+        k2 = after.knees[side]
+        assert not k2["stuck"] and k2["glitches"] == 0 and not k2["steps"] and not k2["wraps"], side
+        if hanging:
+            assert abs(k2["offset"]["rest_median_rad"]) < 1e-3
+        else:
+            assert k2["offset"]["rest_median_rad"] < -0.5
+            assert any(e["step"] == "remove_offset" and "skipped" in e["detail"] and e["detail"].startswith(side)
+                       for e in res.log)

@@ -1,13 +1,11 @@
-"""The loop on robot recordings simulated with one or two undeclared effects.
+"""The loop on robot-format recordings from the simple generator (`helpers_generators.robot`, not the simulator).
 
-Each case draws its parameters from a seeded range and runs the knee simulator (left knee data,
-60 s walking forward at 0.2 m/s on the ground, 100 Hz, with the simulator's sensor noise,
-quantisation and gear friction), then explains the Hall angle with the robot adapter: motor
-angle minus the deflection the effort implies through the declared chain. The engine must name
-the simulated effect first, recover its parameter within the stated relative tolerance (the
-truth in the adapter's units: terms of the spring relative to k in this compliance direction)
-and cut the held-out RMSE by the stated factor. Dead-band and friction are declared by default
-(backlash and gear friction); their cases leave them out of the model instead.
+One knee of a hanging robot stepping in place, 100 Hz, 60 s (thermal softening: 120 s), Hall noise
+0.002 rad, effort noise 0.05 Nm, 12-bit angles. Each case draws its parameter from a seeded range (three
+draws; the first by default, the others with the slow tests), explains the Hall angle with the plain model
+(the spring's k, refitted) and checks that exactly that effect is named and its parameter (library name and
+unit) recovered within the stated relative tolerance. The goal cases with the declared chain are in
+`test_loop_goal.py`.
 """
 
 from __future__ import annotations
@@ -15,76 +13,88 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from helpers_generators import robot
 from seadesign.loop import explain
-from seadesign.loop.sea import ROBOT_DECLARED, robot_loop_data
-from seadesign.twin import KneeConfig, Trial, knee_effects, simulate
+from seadesign.loop.sea import robot_declared, robot_loop_data
 
-TRIAL = Trial("front", 0.2, 60.0)
+DRAWS = [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)]
 
-
-def robot_data(spring: dict, effects: dict[str, dict[str, float]], declared=ROBOT_DECLARED, seed: int = 1):
-    chain = knee_effects(KneeConfig.from_spring(spring), ground=True)
-    for name, values in effects.items():
-        chain = chain.configure(name, enabled=True, **values)
-    df, _ = simulate(spring, [TRIAL], ground=True, effects=chain, seed=seed)
-    return robot_loop_data(df, spring, "l", declared)
-
-
-def draw(seed: int, lo: float, hi: float) -> float:
-    return float(np.random.default_rng(seed).uniform(lo, hi))
-
-
-# label, simulator effects from the value, declared, range, loop effect, parameter, truth(value, k, backlash), tol, factor
-CASES = [
-    ("dead_band", lambda v: {"dead_band": {"width_rad": v}}, ("friction",), (0.02, 0.05), "dead_band", "width",
-     lambda v, k, b: v + b, 0.10, 2.0),
-    ("friction", lambda v: {"gear_friction": {"coulomb_Nm": v}}, ("dead_band",), (0.2, 0.4), "friction", "coulomb",
-     lambda v, k, b: v / k, 0.10, 3.0),
-    ("stiffness_scale", lambda v: {"stiffness_scale": {"scale": v}}, ROBOT_DECLARED, (0.6, 0.85), "stiffness_scale",
-     "scale", lambda v, k, b: v, 0.02, 10.0),
-    ("cubic", lambda v: {"cubic_stiffening": {"k3_Nm_per_rad3": v}}, ROBOT_DECLARED, (4.0, 10.0), "cubic_stiffening",
-     "k3_ratio", lambda v, k, b: v / k, 0.05, 5.0),
-    ("hysteresis", lambda v: {"hysteresis": {"torque_Nm": v, "stiffness_Nm_per_rad": 50.0}}, ROBOT_DECLARED,
-     (0.25, 0.4), "hysteresis", "deflection", lambda v, k, b: v / k, 0.15, 2.0),
-    ("viscoelastic", lambda v: {"viscoelastic": {"maxwell_stiffness_Nm_per_rad": v, "relaxation_time_s": 0.5}},
-     ROBOT_DECLARED, (2.0, 4.0), "viscoelastic", "maxwell_ratio", lambda v, k, b: v / k, 0.10, 3.0),
-    ("thermal", lambda v: {"thermal_softening": {"softening_per_K": v, "loss_factor": 0.02,
-                                                 "heat_capacity_J_per_K": 1.0, "cooling_time_s": 300.0}},
-     ROBOT_DECLARED, (0.008, 0.012), "thermal_softening", "softening_per_J", lambda v, k, b: 0.02 * v, 0.10, 3.0),
-    ("offset", lambda v: {"hall_offset": {"offset_rad": v}}, ROBOT_DECLARED, (0.01, 0.03), "sensor_offset", "offset",
-     lambda v, k, b: v, 0.05, 2.0),
-    ("drift", lambda v: {"hall_drift": {"rate_rad_per_s": v}}, ROBOT_DECLARED, (3e-4, 5e-4), "sensor_drift", "rate",
-     lambda v, k, b: v, 0.10, 1.5),
-    ("delay", lambda v: {"hall_delay": {"delay_s": v}}, ROBOT_DECLARED, (0.03, 0.07), "sensor_delay", "delay",
-     lambda v, k, b: v, 0.10, 5.0),
-]
+# effect key -> (checked parameter, range, fixed parameters, relative tolerance, recording length s); the tolerance
+# is about three times the worst error measured over the three draws (in brackets)
+CASES = {
+    "dead_band": ("width_rad", (0.02, 0.05), {}, 0.05, 60.0),  # [0.018]
+    "friction": ("coulomb_Nm", (0.2, 0.5), {"viscous_Nm_s_per_rad": 0.0}, 0.01, 60.0),  # [0.0035]
+    "stiffness_scale": ("scale", (0.6, 0.85), {}, 0.01, 60.0),  # [0.0037]
+    "cubic_stiffening": ("k3_Nm_per_rad3", (150.0, 300.0), {}, 0.15, 60.0),  # [0.063]
+    "effort_lag": ("time_constant_s", (0.02, 0.08), {}, 0.2, 60.0),  # [0.075]
+    "thermal_softening": ("softening_per_J", (0.012, 0.016), {"cooling_time_s": 300.0}, 0.3, 120.0),  # [0.128]
+    "sensor_offset": ("offset_rad", (0.01, 0.03), {}, 0.02, 60.0),  # [0.0064]
+    "sensor_drift": ("rate_rad_per_s", (3e-4, 5e-4), {}, 0.05, 60.0),  # [0.0155]
+    "sensor_delay": ("delay_s", (0.02, 0.06), {}, 0.01, 60.0),  # [0.0034]
+    "sensor_step": ("size_rad", (0.03, 0.15), {}, 0.01, 60.0),  # [0.0029]
+}
 
 
-@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
-def test_robot_effect_named_first_and_recovered(spring_dict, case):
-    label, make, declared, (lo, hi), key, param, truth, tol, factor = case
-    value = draw(100 + sum(map(ord, label)), lo, hi)
-    ex = explain(robot_data(spring_dict, make(value), declared), declared, max_steps=1)
-    assert ex.steps, f"nothing found; verdict: {ex.verdict()}"
-    step = ex.steps[0]
-    assert step.effect == key, ex.verdict()
-    k, backlash = spring_dict["k_Nm_per_rad"], spring_dict["actuator"]["backlash_rad"]
-    p = step.after.parameters()[key][param]
-    assert p["value"] == pytest.approx(truth(value, k, backlash), rel=tol)
-    assert p["unit"] in ("rad", "1", "1/rad^2", "1/J", "rad/s", "s")
-    assert step.before.errors["held_out"]["rmse"] / step.after.errors["held_out"]["rmse"] >= factor
+def case(key: str, draw_index: int) -> tuple[dict, float, float]:
+    """(effects for the generator, the drawn value, the recording length)."""
+    param, (lo, hi), fixed, _, duration = CASES[key]
+    value = float(np.random.default_rng([draw_index, sum(map(ord, key)), 7]).uniform(lo, hi))
+    values = {param: value, **fixed}
+    if key == "sensor_step":
+        values["time_s"] = round(float(np.random.default_rng([draw_index, 11]).uniform(0.2, 0.8)) * duration, 2)
+    return {key: values}, value, duration
 
 
-def test_robot_clean_recording_adds_nothing(spring_dict):
-    ex = explain(robot_data(spring_dict, {}, seed=5), ROBOT_DECLARED)
-    assert ex.found == [], ex.verdict()
-    assert ex.tests_after["white"]
+def recording(key: str | None, draw_index: int):
+    effects, value, duration = case(key, draw_index) if key else ({}, 0.0, 60.0)
+    return robot(effects, seed=20 + draw_index, duration_s=duration), effects, value
 
 
-def test_robot_two_undeclared_effects(spring_dict):
-    ex = explain(robot_data(spring_dict, {"stiffness_scale": {"scale": 0.75}, "hall_offset": {"offset_rad": 0.02}}),
-                 ROBOT_DECLARED, max_steps=3)
-    assert set(ex.found) == {"stiffness_scale", "sensor_offset"}, ex.verdict()
-    params = ex.final.parameters()
-    assert params["stiffness_scale"]["scale"]["value"] == pytest.approx(0.75, rel=0.02)
-    assert params["sensor_offset"]["offset"]["value"] == pytest.approx(0.02, rel=0.1)
+@pytest.mark.parametrize("draw_index", DRAWS)
+@pytest.mark.parametrize("key", list(CASES))
+def test_robot_effect_named_alone_and_recovered(spring_dict, key, draw_index):
+    df, effects, value = recording(key, draw_index)
+    ex = explain(robot_loop_data(df, spring_dict), [], max_steps=2)
+    assert ex.found == [key] and not ex.ambiguities, ex.verdict()
+    got = ex.final.parameters()[key][CASES[key][0]]["value"]
+    assert got == pytest.approx(value, rel=CASES[key][3])
+    if key == "sensor_step":
+        assert ex.final.parameters()[key]["time_s"]["value"] == pytest.approx(effects[key]["time_s"], abs=0.011)
+
+
+def test_step_plus_drift_and_backlash_plus_friction(spring_dict):
+    """Two undeclared effects of different kinds, both named with their parameters: a Hall step on top of a
+    drift (not read as a ramp of steps, nor as an offset), and a backlash with gear friction (plain model)."""
+    df = robot({"sensor_step": {"size_rad": 0.06, "time_s": 37.0}, "sensor_drift": {"rate_rad_per_s": 4e-4}}, seed=31)
+    ex = explain(robot_loop_data(df, spring_dict), [], max_steps=3)
+    assert sorted(ex.found) == ["sensor_drift", "sensor_step"], ex.verdict()
+    p = ex.final.parameters()
+    assert p["sensor_step"]["size_rad"]["value"] == pytest.approx(0.06, rel=0.03)
+    assert p["sensor_step"]["time_s"]["value"] == pytest.approx(37.0, abs=0.011)
+    assert p["sensor_drift"]["rate_rad_per_s"]["value"] == pytest.approx(4e-4, rel=0.05)
+    # together they bias each other: width 4-11 % high, Coulomb 2-3 % low (seeds 32-34)
+    df = robot({"dead_band": {"width_rad": 0.03}, "friction": {"coulomb_Nm": 0.3}}, seed=32)
+    ex = explain(robot_loop_data(df, spring_dict), [], max_steps=3)
+    assert sorted(ex.found) == ["dead_band", "friction"], ex.verdict()
+    p = ex.final.parameters()
+    assert p["dead_band"]["width_rad"]["value"] == pytest.approx(0.03, rel=0.3)
+    assert p["friction"]["coulomb_Nm"]["value"] == pytest.approx(0.3, rel=0.1)
+
+
+def test_two_steps_are_two_jumps(spring_dict):
+    df = robot({"sensor_step": {"size_rad": 0.08, "time_s": 21.0}}, seed=33)
+    df["l_hall_pos"] = df["l_hall_pos"] - 0.05 * (df["time_s"] >= 44.0)  # a second jump, back down
+    ex = explain(robot_loop_data(df, spring_dict), [], max_steps=3)
+    assert ex.found == ["sensor_step", "sensor_step_2"], ex.verdict()
+    p = ex.final.parameters()
+    jumps = sorted((p[n]["time_s"]["value"], p[n]["size_rad"]["value"]) for n in ex.found)
+    assert jumps[0] == pytest.approx((21.0, 0.08), abs=0.011) and jumps[1] == pytest.approx((44.0, -0.05), abs=0.011)
+
+
+def test_misdeclared_backlash_and_gear_friction_are_unsupported(spring_dict):
+    """Declared effects the data lacks: refitted, reported unsupported and dropped; nothing else is added."""
+    df = robot({}, seed=34)
+    ex = explain(robot_loop_data(df, spring_dict), robot_declared(spring_dict))
+    assert ex.found == [] and ex.unsupported == ["backlash", "gear_friction"], ex.verdict()
+    assert [t.name for t in ex.final.terms] == ["stiffness_scale"]
+    assert ex.final.errors["held_out"]["rmse"] < 0.2 * ex.plain.errors["held_out"]["rmse"]

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from seadesign.constants import G_M_PER_S2
 from seadesign.data import read_bench, read_recording, write_bench, write_recording
 from seadesign.twin import (
     BenchProtocol,
@@ -53,7 +54,7 @@ def test_static_deflection_under_body_weight_on_the_ground(spring_dict):
     cfg = session.config
     link, motor = last["l_hall_pos"], last["l_knee_pos"]
     lean = np.arctan2(cfg.upper_leg_m * np.sin(link), cfg.lower_leg_m + cfg.upper_leg_m * np.cos(link))
-    stance = 0.5 * cfg.stance_weight_share * cfg.mass_kg * 9.80665 * cfg.lower_leg_m * np.sin(lean)
+    stance = 0.5 * cfg.stance_weight_share * cfg.mass_kg * G_M_PER_S2 * cfg.lower_leg_m * np.sin(lean)
     gravity = cfg.gravity_amplitude_Nm * np.sin(link - cfg.hip_flexion_rad)
     assert (motor - link) * spring_dict["k_Nm_per_rad"] == pytest.approx(gravity - stance, rel=1e-3)
 

@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from seadesign.corrector.dataset import KNEES
-from seadesign.corrector.modalities import IMU_CHANNELS, PRESSURE_CHANNELS
+from seadesign.corrector.modalities import FIELD_CHANNELS, IMU_CHANNELS, PRESSURE_CHANNELS
 from seadesign.corrector.runtime import Corrector
 from seadesign.errors import ConfigError, SeadesignError
 from seadesign.twin import KneeSession, Trial, thesis_protocol
@@ -36,8 +36,6 @@ UNSTABLE_COMMAND_RAD = 1.5
 UNSTABLE_HALL_RAD = np.pi
 CHATTER_WINDOW_S = 0.1
 CHATTER_RMS_RAD = 0.02
-_FIELDS = {"knee_pos": "motor_pos_rad", "hall_pos": "hall_pos_rad", "knee_vel": "motor_vel_rad_per_s",
-           "hall_vel": "hall_vel_rad_per_s", "knee_eff": "effort_Nm"}
 _ABSENT = dict.fromkeys(IMU_CHANNELS + PRESSURE_CHANNELS, float("nan"))
 
 
@@ -83,7 +81,7 @@ def run_closed_loop(corrector: Corrector, spring: dict[str, Any], trials: list[T
         cmd = np.empty((sim.n_trials, 2))
         for i, c in enumerate(copies):
             for k, knee in enumerate(KNEES):
-                measured = {dst: float(getattr(obs, src)[i, k]) for src, dst in _FIELDS.items()}
+                measured = {dst: float(getattr(obs, src)[i, k]) for src, dst in FIELD_CHANNELS.items()}
                 cmd[i, k] = c.command(knee, float(obs.target[i, k]), {**measured, **_ABSENT}, sim.dt)
         target[:, obs.step], hall[:, obs.step], command[:, obs.step] = obs.target, obs.hall_pos, cmd
         effort[:, obs.step] = obs.knee_eff

@@ -27,9 +27,10 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from seadesign.corrector.modalities import MIRRORED_CHANNELS, MODALITIES, channels, resolve_modalities
+from seadesign.data import KNEE_NAMES
 from seadesign.errors import DataError, SeadesignError
 
-KNEES = ("left", "right")
+KNEES = tuple(KNEE_NAMES.values())  # ("left", "right")
 TASKS = ("thesis", "inverse", "command")
 COMMAND = "command_pos_rad"  # optional channel: position command sent at t, rad (NaN where none)
 ALL_CHANNELS = channels(tuple(MODALITIES))

@@ -7,7 +7,14 @@ the empty combination.
 
 from __future__ import annotations
 
+from seadesign.data import FIELD_SIGNALS
 from seadesign.errors import SeadesignError
+
+#: signal of the one vocabulary (`seadesign.effects.SIGNALS`) -> the corrector's per-knee channel (unit in the name)
+SIGNAL_CHANNELS = {"motor": "motor_pos_rad", "hall": "hall_pos_rad", "motor_velocity": "motor_vel_rad_per_s",
+                   "hall_velocity": "hall_vel_rad_per_s", "effort": "effort_Nm"}
+#: per-knee field of the robot format (and of the simulator's observation) -> channel
+FIELD_CHANNELS = {field: SIGNAL_CHANNELS[signal] for field, signal in FIELD_SIGNALS.items()}
 
 IMU_CHANNELS = (
     "imu_roll_rad", "imu_pitch_rad", "imu_yaw_rad",

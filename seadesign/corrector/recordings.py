@@ -21,15 +21,12 @@ import numpy as np
 import pandas as pd
 
 from seadesign.corrector.dataset import COMMAND, Recording
-from seadesign.corrector.modalities import IMU_CHANNELS, PRESSURE_CHANNELS
-from seadesign.data import clean, is_hanging, read_recording
+from seadesign.corrector.modalities import FIELD_CHANNELS, IMU_CHANNELS, PRESSURE_CHANNELS
+from seadesign.data import KNEE_NAMES, clean, is_hanging, read_recording
 from seadesign.errors import DataError
 
 GAP_FACTOR = 10.0
 PRESSURE_THRESHOLD = 10.0  # summed foot pressure (8 cells, the robot's cell units) below which a row is "lifted"
-_SIDES = {"left": "l", "right": "r"}
-_KNEE_MAP = {"knee_pos": "motor_pos_rad", "hall_pos": "hall_pos_rad", "knee_vel": "motor_vel_rad_per_s",
-             "hall_vel": "hall_vel_rad_per_s", "knee_eff": "effort_Nm"}
 _IMU_COLUMNS = ["imu_roll_rad", "imu_pitch_rad", "imu_yaw_rad", "imu_gyro_x", "imu_gyro_y", "imu_gyro_z",
                 "imu_acc_x", "imu_acc_y", "imu_acc_z"]
 
@@ -55,9 +52,9 @@ def recording_from_frame(df: pd.DataFrame, name: str, setting: str = "recorded")
     time_s = df["time_s"].to_numpy(dtype=float)
     imu = df[_IMU_COLUMNS].to_numpy(dtype=float)
     knees = {}
-    for knee, s in _SIDES.items():
+    for s, knee in KNEE_NAMES.items():
         other = "r" if s == "l" else "l"
-        ch = {dst: df[f"{s}_{src}"].to_numpy(dtype=float) for src, dst in _KNEE_MAP.items()}
+        ch = {dst: df[f"{s}_{src}"].to_numpy(dtype=float) for src, dst in FIELD_CHANNELS.items()}
         ch[COMMAND] = np.where(df["has_command"].to_numpy(dtype=bool), df[f"{s}_cmd_pos"].to_numpy(dtype=float), np.nan)
         ch.update(zip(IMU_CHANNELS, imu.T))
         cells = np.column_stack([df[[f"{s}_pressure_{i}" for i in range(4)]].to_numpy(float),

@@ -3,7 +3,9 @@
 Public API (stable):
 
 - `read_recording(path) -> DataFrame`, `write_recording(df, path, metadata=None)`: the
-  robot format (`robot.py`, columns in `RECORDING_COLUMNS`).
+  robot format (`robot.py`, columns in `RECORDING_COLUMNS`); `knee_channels(df, knee)`: one knee's
+  channels as signals of the one vocabulary (`FIELD_SIGNALS`: motor, hall, motor_velocity,
+  hall_velocity, effort; flexion convention), knee sides `l`/`r` and names `left`/`right` (`KNEE_NAMES`).
 - `read_bench(path) -> DataFrame`, `write_bench(df, path, metadata=None)`: the bench format
   `time_s, torque_Nm, deflection_rad[, temperature_C]` (`bench.py`).
 - `read_metadata(csv_path)`, `write_metadata(csv_path, dict)`: the `<name>.meta.json` sidecar.
@@ -20,11 +22,22 @@ from seadesign.data.bench import BENCH_OPTIONAL, BENCH_REQUIRED, read_bench, wri
 from seadesign.data.cleaning import CleanResult, clean, is_hanging, quaternion_to_euler, write_cleaned
 from seadesign.data.metadata import read_metadata, sidecar_path, write_metadata
 from seadesign.data.plots import plot_recording
-from seadesign.data.robot import KNEE_SIGN, KNEES, RECORDING_COLUMNS, read_recording, write_recording
+from seadesign.data.robot import (
+    FIELD_SIGNALS,
+    KNEE_NAMES,
+    KNEE_SIGN,
+    KNEES,
+    RECORDING_COLUMNS,
+    KneeChannels,
+    knee_channels,
+    read_recording,
+    write_recording,
+)
 
 __all__ = [
     "ArtefactReport", "CleanResult", "plot_recording", "Thresholds", "clean", "detect_artefacts", "is_hanging", "quaternion_to_euler", "write_cleaned",
-    "BENCH_OPTIONAL", "BENCH_REQUIRED", "KNEES", "KNEE_SIGN", "RECORDING_COLUMNS",
+    "BENCH_OPTIONAL", "BENCH_REQUIRED", "FIELD_SIGNALS", "KNEES", "KNEE_NAMES", "KNEE_SIGN", "KneeChannels",
+    "RECORDING_COLUMNS", "knee_channels",
     "read_bench", "read_metadata", "read_recording", "sidecar_path", "write_bench",
     "write_metadata", "write_recording",
 ]

@@ -26,6 +26,7 @@ non-increasing timestamp) raises DataError naming the line, row and column.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -62,6 +63,37 @@ RECORDING_COLUMNS = (
 )
 #: Sign of each knee in the file: the right knee is mirrored.
 KNEE_SIGN = {"l": 1.0, "r": -1.0}
+#: Knee side in the file -> knee name (the corrector's and the simulator's knee axis: 0 left, 1 right).
+KNEE_NAMES = {"l": "left", "r": "right"}
+#: Per-knee field of the file -> signal of the one vocabulary (`seadesign.effects.SIGNALS`).
+FIELD_SIGNALS = {"knee_pos": "motor", "hall_pos": "hall", "knee_vel": "motor_velocity", "hall_vel": "hall_velocity",
+                 "knee_eff": "effort"}
+
+
+@dataclass(frozen=True)
+class KneeChannels:
+    """One knee's channels as signals of the vocabulary, in flexion convention (the right knee un-mirrored):
+    `signals` name -> array (rad, rad/s, Nm), `columns` name -> the column it came from."""
+
+    knee: str
+    signals: dict[str, np.ndarray]
+    columns: dict[str, str]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.signals[name]
+
+
+def knee_channels(df: pd.DataFrame, knee: str) -> KneeChannels:
+    """The channels of knee `knee` ('l' or 'r', or 'left' / 'right') of a robot-format table."""
+    side = {v: k for k, v in KNEE_NAMES.items()}.get(knee, knee)
+    if side not in KNEE_SIGN:
+        raise DataError(f"knee '{knee}' is unknown; use one of {', '.join(KNEE_SIGN)} (or {', '.join(KNEE_NAMES.values())})")
+    columns = {sig: f"{side}_{f}" for f, sig in FIELD_SIGNALS.items()}
+    missing = [c for c in columns.values() if c not in df.columns]
+    if missing:
+        raise DataError(f"the table lacks column(s) {', '.join(missing)}; read it with read_recording")
+    s = KNEE_SIGN[side]
+    return KneeChannels(side, {sig: s * df[c].to_numpy(dtype=float) for sig, c in columns.items()}, columns)
 
 
 def read_recording(path: str | Path) -> pd.DataFrame:

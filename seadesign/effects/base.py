@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar, Mapping
 
 import numpy as np
+from scipy.signal import lfilter
 
 from seadesign.errors import ConfigError
 
@@ -42,8 +43,10 @@ SIGNALS: dict[str, tuple[str, str]] = {
     "hall": ("rad", "Hall sensor reading of the link angle"),
     "motor": ("rad", "motor encoder reading"),
     "motor_velocity": ("rad/s", "motor output angular velocity"),
+    "hall_velocity": ("rad/s", "finite difference of the Hall reading (as the robot logs it)"),
     "effort": ("Nm", "torque the servo reports (from its current)"),
     "temperature": ("degC", "measured spring temperature (optional)"),
+    "energy": ("J", "cumulative dissipated energy (optional)"),
 }
 
 
@@ -59,16 +62,43 @@ class Param:
     doc: str
 
 
+@dataclass(frozen=True)
+class Scales:
+    """Typical sizes of the data an effect is fitted to: what its data-dependent bounds and starts scale with.
+
+    `deflection_rad` largest |deflection|, `torque_Nm` largest |spring torque|, `velocity_rad_per_s`
+    90 % quantile of the |velocity| that drives friction, `duration_s` record length, `dt_s` median
+    sample interval, `k_Nm_per_rad` slope of the spring, `measured_span` span of the reading the sensor
+    effects act on (the measured channel, or a bench's deflection reading; in its unit). Names carry the SEA units; on a generic table they stand for the table's units.
+    """
+
+    deflection_rad: float = 1.0
+    torque_Nm: float = 1.0
+    velocity_rad_per_s: float = 1.0
+    duration_s: float = 1.0
+    dt_s: float = 0.01
+    k_Nm_per_rad: float = 1.0
+    measured_span: float = 1.0
+    temperature_C: float = 23.0  # at the first sample, when the data has a temperature
+    generic: bool = False  # a table of unknown sign conventions: loads and delays may take either sign
+
+
+#: A fit's search space for one effect: bounds name -> (lower, upper) (equal bounds: held fixed) and start points.
+Search = tuple[dict[str, tuple[float, float]], list[dict[str, float]]]
+
+
 class Effect:
     """Base class; subclasses set the class attributes and implement `_map` or the stateful trio."""
 
     key: ClassVar[str]
     summary: ClassVar[str]
+    signature: ClassVar[str] = ""  # what the effect leaves in a residual when a model lacks it
     parameters: ClassVar[tuple[Param, ...]] = ()
     reads: ClassVar[tuple[str, ...]] = ()
     writes: ClassVar[str]
     stateful: ClassVar[bool] = False
     random: ClassVar[bool] = False
+    log_params: ClassVar[tuple[str, ...]] = ()  # positive scale parameters a fitter searches in log space
 
     def __init__(self, name: str | None = None, *, enabled: bool = True,
                  bind: Mapping[str, str] | None = None, **values: float) -> None:
@@ -113,6 +143,11 @@ class Effect:
         """Lower and upper bounds in the order of `parameters`."""
         return (np.array([p.lower for p in self.parameters]), np.array([p.upper for p in self.parameters]))
 
+    def search(self, scales: Scales) -> Search:
+        """Bounds and start points for fitting this effect to data of the given `scales` (the fitter's search
+        space, within the physical bounds). Default: the physical bounds, started at the instance's values."""
+        return {p.name: (p.lower, p.upper) for p in self.parameters}, [dict(self.values)]
+
     # -- signals ----------------------------------------------------------------------
     def roles(self) -> tuple[str, ...]:
         return tuple(dict.fromkeys((*self.reads, self.writes)))
@@ -154,6 +189,13 @@ class Effect:
         if not self.stateful:
             return self._map(x, p, _rng(rng))
         return self._apply_stateful(x, p)
+
+    def evaluate(self, signals: Signals, values: Mapping[str, float]) -> np.ndarray:
+        """`apply` with trial `values` (name -> value, over the instance's) taken unchecked: a fitter's
+        search may leave the physical bounds where a table's sign convention is unknown."""
+        p = {**self.values, **values}
+        x = self._inputs(signals)
+        return self._apply_stateful(x, p) if self.stateful else self._map(x, p, None if not self.random else _rng(None))
 
     def init_state(self, sample: Signals, params: Mapping[str, float] | None = None) -> dict[str, Any]:
         """State before the first step, from the first sample (batch-shaped arrays)."""
@@ -224,12 +266,34 @@ def rows(*arrays: np.ndarray) -> list[tuple[list[float], ...]]:
     return [tuple(f[i].tolist() for f in flat) for i in range(flat[0].shape[0])]
 
 
+def uniform_step(time: np.ndarray) -> float | None:
+    """The sample interval (s) when `time` (1-D) is uniformly sampled to 1e-9 relative, else None."""
+    time = np.asarray(time, dtype=float)
+    if time.ndim != 1 or time.size < 2:
+        return None
+    dt = np.diff(time)
+    return float(dt.mean()) if np.ptp(dt) <= 1e-9 * abs(dt.mean()) else None
+
+
+def lowpass_uniform(x: np.ndarray, dt: float, tau: float) -> np.ndarray:
+    """First-order lag of x (time last) with time constant tau (s) at a uniform sample interval dt (s),
+    starting at x[..., 0]: the recursion of `lowpass` as one linear filter (`scipy.signal.lfilter`)."""
+    x = np.asarray(x, dtype=float)
+    a = math.exp(-dt / tau)
+    y, _ = lfilter([1.0 - a], [1.0, -a], x, axis=-1, zi=a * x[..., :1])
+    return y
+
+
 def lowpass(x: np.ndarray, time: np.ndarray, tau: float) -> np.ndarray:
     """First-order lag y' = (x - y) / tau (tau s) along the last axis, y starting at x[..., 0].
 
     Discretised exactly for x held over each step: y_n = y_{n-1} + (x_n - y_{n-1})(1 - exp(-dt_n/tau)).
+    Uniformly sampled records go through `lowpass_uniform` (the same recursion, vectorised).
     """
     x = np.asarray(x, dtype=float)
+    dt = uniform_step(time)
+    if dt is not None:
+        return lowpass_uniform(np.broadcast_to(x, np.broadcast_shapes(x.shape, np.shape(time))), dt, tau)
     shape = np.broadcast_shapes(x.shape, np.shape(time))
     out = np.empty(shape)
     out_rows = out.reshape(-1, shape[-1])

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from seadesign.constants import G_M_PER_S2, WOLFGANG_LOWER_LEG_M, WOLFGANG_MASS_KG
-from seadesign.effects.base import Effect, Param
+from seadesign.effects.base import Effect, Param, Scales, Search
 
 
 
@@ -24,12 +24,21 @@ class Friction(Effect):
         Param("viscous_Nm_s_per_rad", "Nm s/rad", 0.02, 0.0, 50.0, "viscous coefficient Fv"),
         Param("smoothing_rad_per_s", "rad/s", 0.05, 1e-5, 10.0, "velocity vs below which the Coulomb term fades"),
     )
+    signature = "jump at v = 0 and slope vs v"
     reads = ("velocity",)
     writes = "load_torque"
+    log_params = ("smoothing_rad_per_s",)
 
     def _map(self, x, p, rng):
         v = x["velocity"]
         return x["load_torque"] + p["coulomb_Nm"] * np.tanh(v / p["smoothing_rad_per_s"]) + p["viscous_Nm_s_per_rad"] * v
+
+    def search(self, s: Scales) -> Search:
+        span, v = s.torque_Nm, s.velocity_rad_per_s
+        low = -1.0 if s.generic else 0.0  # friction opposes motion; a generic table's sign is its own
+        return ({"coulomb_Nm": (low * span, span), "viscous_Nm_s_per_rad": (low * 100 * span / v, 100 * span / v),
+                 "smoothing_rad_per_s": (1e-4 * v, v)},
+                [{"coulomb_Nm": 0.01 * span, "viscous_Nm_s_per_rad": 0.0, "smoothing_rad_per_s": f * v} for f in (0.02, 0.2)])
 
 
 class GravityLoad(Effect):
@@ -41,11 +50,16 @@ class GravityLoad(Effect):
         Param("amplitude_Nm", "Nm", 0.6, 0.0, 100.0, "m g l_c of the lower leg and foot"),
         Param("angle_offset_rad", "rad", 0.0, -np.pi, np.pi, "angle phi at which the leg hangs straight down, negated"),
     )
+    signature = "follows the link angle, present at v = 0"
     reads = ("angle",)
     writes = "load_torque"
 
     def _map(self, x, p, rng):
         return x["load_torque"] + p["amplitude_Nm"] * np.sin(x["angle"] + p["angle_offset_rad"])
+
+    def search(self, s: Scales) -> Search:
+        return ({"amplitude_Nm": (0.0, min(100.0, 2 * s.torque_Nm)), "angle_offset_rad": (-np.pi, np.pi)},
+                [{"amplitude_Nm": 0.1 * s.torque_Nm, "angle_offset_rad": phi} for phi in (-2.0, 0.0, 2.0)])
 
 
 class StanceLoad(Effect):

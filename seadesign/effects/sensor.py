@@ -1,7 +1,8 @@
 """Sensor effects: what a reading adds to the true value. Bound by default to `hall`.
 
-Bind them to `motor` or `effort` for the other channels (the parameter's unit is then the
-unit of that signal; the units below are for the default Hall binding).
+Bind them to `motor`, `effort` or `deflection` for the other channels (the parameter's unit is
+then the unit of that signal; the units below are for the default Hall binding). `EffortLag`
+is the servo's current-based effort: a first-order lag of the torque it reports.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import math
 
 import numpy as np
 
-from seadesign.effects.base import Effect, Param
+from seadesign.effects.base import Effect, Param, Scales, Search, lowpass
 
 
 class SensorOffset(Effect):
@@ -18,11 +19,15 @@ class SensorOffset(Effect):
 
     key = "sensor_offset"
     summary = "reading += c"
+    signature = "mean shift"
     parameters = (Param("offset_rad", "rad", 0.02, -math.pi, math.pi, "offset c"),)
     writes = "hall"
 
     def _map(self, x, p, rng):
         return x["hall"] + p["offset_rad"]
+
+    def search(self, s: Scales) -> Search:
+        return {"offset_rad": (-s.measured_span, s.measured_span)}, [{"offset_rad": 0.0}]
 
 
 class SensorDrift(Effect):
@@ -30,6 +35,7 @@ class SensorDrift(Effect):
 
     key = "sensor_drift"
     summary = "reading += r (t - t0)"
+    signature = "ramp over the recording"
     parameters = (Param("rate_rad_per_s", "rad/s", 1e-4, -0.01, 0.01, "drift rate r"),)
     reads = ("time",)
     writes = "hall"
@@ -44,12 +50,50 @@ class SensorDrift(Effect):
     def _apply_stateful(self, x, p):
         return x["hall"] + p["rate_rad_per_s"] * (x["time"] - x["time"][..., :1])
 
+    def search(self, s: Scales) -> Search:
+        bound = 10.0 * s.measured_span / s.duration_s
+        return {"rate_rad_per_s": (-bound, bound)}, [{"rate_rad_per_s": 0.0}]
+
+
+class SensorStep(Effect):
+    """A jump of the reading at one instant: reading += h for t >= t_j (a Hall sensor's level step).
+
+    Several jumps are several instances. Unlike an offset (present from the start) or a drift (a
+    ramp), it changes the reading at one unknown instant, which a fitter finds by change-point
+    detection (`seadesign.loop.changepoint`) and then holds fixed while it fits the size.
+    """
+
+    key = "sensor_step"
+    summary = "reading += h for t >= t_j"
+    signature = "level shift at one instant"
+    parameters = (
+        Param("time_s", "s", 0.0, 0.0, 1e9, "instant t_j of the jump (time from the recording's start)"),
+        Param("size_rad", "rad", 0.05, -2 * math.pi, 2 * math.pi, "size h of the jump"),
+    )
+    reads = ("time",)
+    writes = "hall"
+    stateful = True  # needs the recording's start time
+
+    def _init(self, x, p):
+        return {"t0": np.asarray(x["time"], dtype=float).copy()}
+
+    def _advance(self, state, x, dt, p):
+        return x["hall"] + p["size_rad"] * (x["time"] - state["t0"] >= p["time_s"])
+
+    def _apply_stateful(self, x, p):
+        return x["hall"] + p["size_rad"] * (x["time"] - x["time"][..., :1] >= p["time_s"])
+
+    def search(self, s: Scales) -> Search:
+        return ({"time_s": (self.values["time_s"],) * 2, "size_rad": (-s.measured_span, s.measured_span)},
+                [dict(self.values)])
+
 
 class SensorDelay(Effect):
     """Pure delay: reading(t) = value(t - td), linear interpolation, held at the first value."""
 
     key = "sensor_delay"
     summary = "reading(t) = value(t - td)"
+    signature = "residual about -td x rate; cross-correlation peak at a non-zero lag"
     parameters = (Param("delay_s", "s", 0.01, 0.0, 1.0, "delay td"),)
     reads = ("time",)
     writes = "hall"
@@ -80,6 +124,10 @@ class SensorDelay(Effect):
         for idx in np.ndindex(v.shape[:-1]):
             out[idx] = np.interp(t[idx] - p["delay_s"], t[idx], v[idx])
         return out
+
+    def search(self, s: Scales) -> Search:
+        hi = min(1.0, 0.1 * s.duration_s)
+        return {"delay_s": (-hi if s.generic else 0.0, hi)}, [{"delay_s": td} for td in (0.005, 0.03, 0.15)]
 
 
 class SensorNoise(Effect):
@@ -119,3 +167,40 @@ class AngleWrap(Effect):
     def _map(self, x, p, rng):
         c = p["centre_rad"]
         return np.mod(x["hall"] - c + math.pi, 2.0 * math.pi) - math.pi + c
+
+
+class EffortLag(Effect):
+    """The servo's effort as a first-order lag of the torque it reports: effort' = (torque - effort) / te.
+
+    The effort is computed from the motor current, which the servo filters; a lag te shows as
+    structure against velocity in a model that reads the effort as the spring torque. Its inverse,
+    torque = effort + te effort' (`torque_from_effort`), is what a model predicting from the effort uses.
+    """
+
+    key = "effort_lag"
+    summary = "effort = lowpass(torque, te)"
+    signature = "residual against velocity / torque rate; effort behind the spring torque"
+    parameters = (Param("time_constant_s", "s", 0.02, 1e-4, 2.0, "time constant te of the lag"),)
+    reads = ("time",)
+    writes = "effort"
+    stateful = True
+    log_params = ("time_constant_s",)
+
+    def _init(self, x, p):
+        return {"y": np.asarray(x["effort"], dtype=float).copy()}
+
+    def _advance(self, state, x, dt, p):
+        state["y"] = state["y"] + (x["effort"] - state["y"]) * (1.0 - math.exp(-dt / p["time_constant_s"]))
+        return state["y"].copy()
+
+    def _apply_stateful(self, x, p):
+        return lowpass(x["effort"], x["time"], p["time_constant_s"])
+
+    @staticmethod
+    def torque_from_effort(effort: np.ndarray, effort_rate: np.ndarray, time_constant_s: float) -> np.ndarray:
+        """The torque (Nm) a lagged `effort` (Nm) reports, from its rate (Nm/s): effort + te effort'."""
+        return effort + time_constant_s * effort_rate
+
+    def search(self, s: Scales) -> Search:
+        return ({"time_constant_s": (0.5 * s.dt_s, 1.0)},
+                [{"time_constant_s": te} for te in (0.01, 0.05, 0.2)])

@@ -1,24 +1,28 @@
-"""Close the loop with measured data: residual, missing effect, refit, error before and after.
+"""Close the loop with measured data: the declared model refitted, missing effects traced, error before and after.
 
 Generic engine (any table with a measured column, a prediction column and signals with roles):
 
 - `LoopData`, `from_frame`, `ROLES` (`table.py`); `metrics` (`metrics.py`);
-- `CANDIDATES` / `LIBRARY` of candidate effects (`candidates.py`), `fit` / `predict` (`fit.py`);
-- `explain(data, declared) -> Explanation` (`engine.py`); `residual_tests` (`whiteness.py`).
+- `Term`, `CANDIDATES` (library keys the loop traces), `predict` (`terms.py`): where each effect of
+  the one library (`seadesign.effects`) acts in the model;
+- `EffectModel(terms).fit(data, held)` / `.predict` / `.score` / `.parameters()` (`model.py`);
+- `explain(data, declared) -> Explanation` (`engine.py`); `residual_tests` (`whiteness.py`);
+  `best_split` (`changepoint.py`).
 
-SEA adapters (`sea.py`) build `LoopData` from a bench file or a robot recording and a
-spring.json; `report.py` writes Markdown, HTML, JSON, plots and the calibration JSON.
+SEA adapters (`sea.py`) build `LoopData` and the declared effects from a bench file or a robot
+recording and a spring.json; `report.py` writes Markdown, HTML, JSON, plots and the calibration JSON.
 """
 
-from seadesign.loop.candidates import CANDIDATES, LIBRARY, Candidate
-from seadesign.loop.engine import Explanation, Step, TraceEntry, explain
-from seadesign.loop.fit import Fit, fit, predict
+from seadesign.loop.changepoint import best_split
+from seadesign.loop.engine import DeclaredCheck, Explanation, Step, TraceEntry, explain
 from seadesign.loop.metrics import metrics, split_metrics
+from seadesign.loop.model import EffectModel, Fit
 from seadesign.loop.table import ROLES, LoopData, LoopInputError, from_frame, time_blocks
+from seadesign.loop.terms import CANDIDATES, Term, predict
 from seadesign.loop.whiteness import residual_tests
 
 __all__ = [
-    "CANDIDATES", "LIBRARY", "ROLES", "Candidate", "Explanation", "Fit", "LoopData", "LoopInputError", "Step",
-    "TraceEntry", "explain", "fit", "from_frame", "metrics", "predict", "residual_tests", "split_metrics",
-    "time_blocks",
+    "CANDIDATES", "ROLES", "DeclaredCheck", "EffectModel", "Explanation", "Fit", "LoopData", "LoopInputError", "Step",
+    "Term", "TraceEntry", "best_split", "explain", "from_frame", "metrics", "predict", "residual_tests",
+    "split_metrics", "time_blocks",
 ]

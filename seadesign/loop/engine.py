@@ -1,17 +1,24 @@
-"""The loop: residual -> trace every undeclared candidate -> add the winner, refit all -> repeat.
+"""The loop: refit the declared model, trace every undeclared effect, add the winner, repeat; then test
+what was declared.
 
-Stopping rule (what "significant" means here): a candidate is accepted only when, fitted
-together with the effects already added, it
+1. The declared model as given (`reference`): the spring (k, or the large-deflection curve) and the
+   declared effects at their declared values. Its error is the "before".
+2. The declared model refitted (`base`): every declared parameter free, started at its declared
+   value, and the stiffness scale (the declared k is always refitted).
+3. Forward selection: each undeclared effect of the library that applies is fitted together with
+   the current model (screened first with the declared effects but the stiffness scale held; the
+   `screen` best, and any the screen accepts, refitted with everything free); it is accepted when it cuts the held-out RMSE by at least `min_gain` (5 %)
+   and lowers the training BIC by at least `min_bic_drop` (10, "very strong" evidence). The winner
+   is the accepted one with the lowest held-out RMSE, except that a fit pinned at a search bound
+   wins only when no accepted fit lies inside its bounds. When the runner-up is as good (held-out
+   RMSE within `ambiguity`, 3 %) and the two together do not beat the winner by `min_gain`, the data
+   cannot tell them apart: the step is reported as an ambiguity with both fits, not a single name.
+   A sensor step is proposed at the instant change-point detection finds in the current residual.
+4. Declared effects are tested: one that can be dropped without raising the held-out RMSE by
+   `min_gain` (or the BIC by `min_bic_drop`) is unsupported and dropped; the stiffness scale differs
+   from the declared k (and is named) only when holding it at 1 fails the same test.
 
-1. cuts the held-out RMSE by at least `min_gain` (default 5 %) relative to the current model, and
-2. lowers the training BIC by at least `min_bic_drop` (default 10, "very strong" evidence).
-
-The winner is the accepted candidate with the lowest held-out RMSE, except that a candidate whose
-fitted parameters sit on a search bound (a limit, not an estimate: the effect is being stretched
-to imitate something else) wins only when no accepted candidate fits inside its bounds. The loop stops when no
-candidate is accepted (or after `max_steps`). An effect is therefore only ever named when it
-beats the model without it, and so the plain model, on held-out data. When the final
-residual still fails the whiteness tests, the report says so and where the structure is.
+An effect is therefore only named when it beats the model without it on held-out data.
 """
 
 from __future__ import annotations
@@ -21,10 +28,14 @@ from typing import Sequence
 
 import numpy as np
 
-from seadesign.loop.candidates import CANDIDATES
-from seadesign.loop.fit import Fit, fit, warm_starts
+from seadesign.effects import LIBRARY, Effect, SensorStep, StiffnessScale
+from seadesign.loop.changepoint import best_split
+from seadesign.loop.model import EffectModel, Fit, evaluate
 from seadesign.loop.table import LoopData, LoopInputError, time_blocks
+from seadesign.loop.terms import CANDIDATES, Term, applicable
 from seadesign.loop.whiteness import residual_tests
+
+SCALE = "stiffness_scale"
 
 
 @dataclass
@@ -42,12 +53,36 @@ class TraceEntry:
 
 @dataclass
 class Step:
-    """One added effect: the model before and after, and every candidate tried."""
+    """One added effect: the model before and after, every candidate tried, and (an ambiguity) the
+    equally good alternative."""
 
     effect: str
     before: Fit
     after: Fit
     trace: list[TraceEntry]
+    alternative: TraceEntry | None = None
+
+
+@dataclass
+class DeclaredCheck:
+    """A declared effect after refitting: declared and fitted values, and whether the data supports it."""
+
+    name: str
+    key: str
+    declared: dict[str, float]
+    fitted: dict[str, dict]
+    supported: bool
+    held_out_rmse_without: float
+    held_out_rmse_with: float
+
+    def text(self) -> str:
+        parts = [f"{p} declared {self.declared[p]:.4g}, data says {v['value']:.4g} +- {v['uncertainty']:.2g} {v['unit']}"
+                 for p, v in self.fitted.items() if not v["held"]]
+        if self.key == SCALE:
+            verdict = "differs from the declared k" if self.supported else "consistent with the declared k"
+        else:
+            verdict = "supported" if self.supported else "unsupported by the data (dropped)"
+        return f"{self.name}: {'; '.join(parts)} ({verdict}; held-out RMSE without it {self.held_out_rmse_without:.4g})"
 
 
 @dataclass
@@ -57,28 +92,49 @@ class Explanation:
     data: LoopData
     held: np.ndarray
     plain: Fit
+    base: Fit
     final: Fit
     steps: list[Step]
     last_trace: list[TraceEntry]
+    declared: list[DeclaredCheck]
     tests_before: dict
     tests_after: dict
     settings: dict = field(default_factory=dict)
 
     @property
-    def found(self) -> list[str]:
+    def added(self) -> list[str]:
+        """Undeclared effects added, in order (an ambiguous step under its winner's name)."""
         return [s.effect for s in self.steps]
 
+    @property
+    def found(self) -> list[str]:
+        """Named effects: the stiffness scale when it differs from the declared k, then the effects added."""
+        scale = [c.name for c in self.declared if c.key == SCALE and c.supported]
+        return scale + self.added
+
+    @property
+    def ambiguities(self) -> list[tuple[str, str]]:
+        return [(s.effect, s.alternative.effect) for s in self.steps if s.alternative is not None]
+
+    @property
+    def unsupported(self) -> list[str]:
+        return [c.name for c in self.declared if c.key != SCALE and not c.supported]
+
     def verdict(self) -> str:
-        """One paragraph: what was found, and whether structure is left (and where)."""
-        h0 = self.plain.errors["held_out"]["rmse"]
-        h1 = self.final.errors["held_out"]["rmse"]
+        """One paragraph: what was found, what the declared model's parameters became, structure left."""
+        h0, h1 = self.plain.errors["held_out"]["rmse"], self.final.errors["held_out"]["rmse"]
         unit = self.data.measured_unit
-        if self.steps:
-            text = (f"Added {', '.join(self.found)}: held-out RMSE {h0:.4g} -> {h1:.4g} {unit} "
-                    f"({h0 / max(h1, 1e-300):.3g}x lower).")
+        named = [f"{a} or {b} (the data cannot tell them apart)" if (a, b) in self.ambiguities else a
+                 for a, b in [(n, dict(self.ambiguities).get(n)) for n in self.found]]
+        if named:
+            text = f"Found {', '.join(named)}: held-out RMSE {h0:.4g} -> {h1:.4g} {unit} ({h0 / max(h1, 1e-300):.3g}x lower)."
         else:
-            text = (f"No candidate effect gives a significant held-out improvement over the plain model "
-                    f"(held-out RMSE {h0:.4g} {unit}); nothing is named.")
+            text = (f"No effect gives a significant held-out improvement over the declared model "
+                    f"(held-out RMSE {h0:.4g} -> {h1:.4g} {unit}); nothing is named.")
+        if self.unsupported:
+            text += f" Declared but unsupported by the data: {', '.join(self.unsupported)}."
+        if not self.final.converged:
+            text += " The final fit did not converge (evaluation limit): its numbers are not a result."
         s = self.tests_after["strongest"]
         if self.tests_after["white"]:
             text += " The residual passes the whiteness tests: no structure is left that the tests can see."
@@ -89,49 +145,128 @@ class Explanation:
         return text
 
 
-def _signals(data: LoopData) -> dict[str, np.ndarray]:
-    return dict(data.signals)
+def _term(key: str, data: LoopData, current: Fit) -> Term | None:
+    """A fresh candidate term for `key` (a sensor step at the instant the current residual jumps)."""
+    if key != "sensor_step":
+        return Term(key, LIBRARY[key]())
+    taken = [current.values[t.name]["time_s"] for t in current.terms if t.key == "sensor_step"]
+    index = best_split(data.measured - current.prediction, min_size=max(10, data.n // 10),  # ends: an offset
+                       exclude=[int(np.searchsorted(data.time - data.time[0], s)) for s in taken])
+    if index is None:
+        return None
+    name = "sensor_step" if not taken else f"sensor_step_{len(taken) + 1}"
+    return Term(name, SensorStep(name, time_s=float(data.time[index] - data.time[0])))
 
 
-def explain(data: LoopData, declared: Sequence[str] = (), *, min_gain: float = 0.05, min_bic_drop: float = 10.0,
-            max_steps: int = 4, n_blocks: int = 10, held_out_blocks: tuple[int, ...] = (2, 7),
-            candidates: Sequence[str] | None = None) -> Explanation:
-    """Run the loop on `data`; `declared` effects (already in the prediction) are not tried."""
-    known = {c.key for c in CANDIDATES}
-    for key in [*declared, *(candidates or [])]:
-        if key not in known:
-            raise LoopInputError(f"unknown effect '{key}'; the library has: {', '.join(sorted(known))}")
-    pool = [c.key for c in CANDIDATES if c.applicable(data) and c.key not in declared
-            and (candidates is None or c.key in candidates)]
+def _pinned(f: Fit, name: str) -> bool:
+    return any(p["at_bound"] for p in f.parameters()[name].values())
+
+
+def _fit(data: LoopData, terms: list[Term], held: np.ndarray, warm: dict | None = None,
+         fixed: dict | None = None) -> Fit:
+    return EffectModel(terms, fixed).fit(data, held, warm).fit_
+
+
+def explain(data: LoopData, declared: Sequence[Effect] = (), *, exclude: Sequence[str] = (), min_gain: float = 0.05,
+            min_bic_drop: float = 10.0, ambiguity: float = 0.03, max_steps: int = 4, screen: int = 3, n_blocks: int = 10,
+            held_out_blocks: tuple[int, ...] = (2, 7), candidates: Sequence[str] | None = None) -> Explanation:
+    """Run the loop on `data` with the `declared` effects (library effects with their declared values);
+    `exclude`: library keys not traced (effects a generic table's prediction already holds)."""
+    for key in [*exclude, *(candidates or [])]:
+        if key not in CANDIDATES:
+            raise LoopInputError(f"unknown effect '{key}'; the loop traces: {', '.join(sorted(CANDIDATES))}")
     held = time_blocks(data.n, n_blocks, held_out_blocks)
-    plain = fit(data, (), held)
-    current, steps, trace = plain, [], []
+    decl = ([Term(SCALE, StiffnessScale(), declared=True)] if applicable(SCALE, data) else []) + \
+           [Term(e.name, e, declared=True) for e in declared]
+    declared_keys = {t.key for t in decl}
+    pool = [k for k in CANDIDATES if applicable(k, data) and k not in declared_keys and k not in exclude
+            and (candidates is None or k in candidates)]
+    plain = evaluate(data, decl, {t.name: dict(t.effect.values) for t in decl}, held)
+    base = _fit(data, decl, held)
+    current, steps, trace = base, [], []
+
+    def gate(f: Fit, ref: Fit) -> bool:
+        return f.errors["held_out"]["rmse"] <= (1 - min_gain) * ref.errors["held_out"]["rmse"] and f.bic <= ref.bic - min_bic_drop
+
     for _ in range(max_steps):
-        trace = []
-        base_h = current.errors["held_out"]["rmse"]
-        warm = warm_starts(current, data)
-        for key in pool:
-            if key in current.keys:
-                continue
-            f = fit(data, current.keys + (key,), held, warm)
-            h = f.errors["held_out"]["rmse"]
-            ok = h <= (1.0 - min_gain) * base_h and f.bic <= current.bic - min_bic_drop
-            pinned = any(p["at_bound"] for p in f.parameters()[key].values())
-            trace.append(TraceEntry(key, f, h, f.bic, f.aic, ok, pinned))
+        trace = _trace(data, held, current, pool, gate, screen)
         trace.sort(key=lambda t: t.held_out_rmse)
         winners = sorted((t for t in trace if t.accepted), key=lambda t: t.at_bound)  # stable: RMSE order kept
         if not winners:
             break
         best = winners[0]
-        steps.append(Step(best.effect, current, best.fit, trace))
+        alt = _alternative(data, held, best, winners[1:], ambiguity, min_gain)
+        steps.append(Step(best.effect, current, best.fit, trace, alt))
         current = best.fit
-    sig = _signals(data)
+    checks, current = _check_declared(data, held, current, decl, gate)
+    sig = dict(data.signals)
     return Explanation(
-        data=data, held=held, plain=plain, final=current, steps=steps,
-        last_trace=trace,
+        data=data, held=held, plain=plain, base=base, final=current, steps=steps, last_trace=trace, declared=checks,
         tests_before=residual_tests(data.measured - plain.prediction, data.time, sig),
         tests_after=residual_tests(data.measured - current.prediction, data.time, sig),
-        settings={"min_gain": min_gain, "min_bic_drop": min_bic_drop, "max_steps": max_steps,
-                  "n_blocks": n_blocks, "held_out_blocks": list(held_out_blocks), "declared": list(declared),
-                  "candidates": pool},
+        settings={"min_gain": min_gain, "min_bic_drop": min_bic_drop, "ambiguity": ambiguity, "max_steps": max_steps,
+                  "screen": screen, "n_blocks": n_blocks, "held_out_blocks": list(held_out_blocks),
+                  "declared": [t.name for t in decl], "excluded": list(exclude), "candidates": pool},
     )
+
+
+def _trace(data: LoopData, held: np.ndarray, current: Fit, pool: list[str], gate, screen: int) -> list[TraceEntry]:
+    """Every candidate fitted with the current model: first screened (the declared effects but the stiffness
+    scale held), then the `screen` best and every one the screen already accepts refitted with all free."""
+    held_values = {t.name: current.values[t.name] for t in current.terms if t.declared and t.key != SCALE}
+    screened = []
+    for key in pool:
+        if key in {t.key for t in current.terms} and key != "sensor_step":
+            continue
+        term = _term(key, data, current)
+        if term is not None:
+            f = _fit(data, current.terms + [term], held, current.values, fixed=held_values)
+            screened.append((term, f))
+    screened.sort(key=lambda tf: tf[1].errors["held_out"]["rmse"])
+    trace = []
+    for i, (term, f) in enumerate(screened):
+        if i < screen or gate(f, current):
+            f = _fit(data, current.terms + [term], held, {**current.values, term.name: f.values[term.name]})
+        trace.append(TraceEntry(term.name, f, f.errors["held_out"]["rmse"], f.bic, f.aic, gate(f, current),
+                                _pinned(f, term.name)))
+    return trace
+
+
+def _alternative(data, held, best: TraceEntry, others: list[TraceEntry], ambiguity: float,
+                 min_gain: float) -> TraceEntry | None:
+    """The runner-up when the data cannot tell it from the winner: within `ambiguity` in held-out RMSE, inside
+    its bounds, and not adding `min_gain` when fitted together with the winner."""
+    inside = [t for t in others if not t.at_bound]
+    if not inside or best.at_bound:
+        return None
+    alt = inside[0]
+    if alt.held_out_rmse > (1 + ambiguity) * best.held_out_rmse:
+        return None
+    both = _fit(data, best.fit.terms + [alt.fit.term(alt.effect)], held, {**best.fit.values, **alt.fit.values})
+    return alt if both.errors["held_out"]["rmse"] > (1 - min_gain) * best.held_out_rmse else None
+
+
+def _check_declared(data, held, current: Fit, decl: list[Term], gate) -> tuple[list[DeclaredCheck], Fit]:
+    """Each declared effect against the model without it: drop the unsupported ones, weakest first, until
+    every declared effect left is supported; then the scale against the final model with it held at 1."""
+    checks: dict[str, DeclaredCheck] = {}
+    while True:
+        trials = [(t, _fit(data, [u for u in current.terms if u.name != t.name], held, current.values))
+                  for t in decl if t.key != SCALE and t.name not in checks]
+        weak = [(t, w) for t, w in trials if not gate(current, w)]
+        if not weak:
+            checks.update({t.name: _check(t, current, w, True) for t, w in trials})
+            break
+        t, without = min(weak, key=lambda tw: tw[1].errors["held_out"]["rmse"])
+        checks[t.name] = _check(t, current, without, False)
+        current = without
+    for t in decl:
+        if t.key == SCALE:
+            without = _fit(data, current.terms, held, current.values, fixed={t.name: {"scale": 1.0}})
+            checks[t.name] = _check(t, current, without, gate(current, without))
+    return [checks[t.name] for t in decl], current
+
+
+def _check(t: Term, with_: Fit, without: Fit, supported: bool) -> DeclaredCheck:
+    return DeclaredCheck(t.name, t.key, dict(t.effect.values), with_.parameters()[t.name], supported,
+                         without.errors["held_out"]["rmse"], with_.errors["held_out"]["rmse"])

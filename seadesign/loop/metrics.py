@@ -6,7 +6,9 @@ import numpy as np
 
 
 def metrics(measured: np.ndarray, predicted: np.ndarray) -> dict[str, float]:
-    """RMSE, peak |error|, mean error (bias) and fit % = 100 (1 - |e| / |y - mean y|)."""
+    """RMSE, peak |error|, mean error (bias) and fit % = 100 (1 - |e| / |y - mean y|); NaN for no samples."""
+    if measured.size == 0:
+        return dict.fromkeys(("rmse", "peak", "bias", "fit_percent"), float("nan"))
     e = measured - predicted
     spread = np.linalg.norm(measured - measured.mean())
     return {

@@ -17,10 +17,10 @@ import numpy as np  # noqa: E402
 from seadesign.loop.engine import Explanation, TraceEntry  # noqa: E402
 
 
-
 def _trace_row(t: TraceEntry) -> dict:
     return {"effect": t.effect, "held_out_rmse": t.held_out_rmse, "bic": t.bic, "aic": t.aic,
             "accepted": t.accepted, "at_bound": t.at_bound}
+
 
 def _errors(e: dict) -> dict:
     return {part: {k: float(v) for k, v in m.items()} for part, m in e.items()}
@@ -37,15 +37,24 @@ def to_json(ex: Explanation, title: str) -> dict[str, Any]:
         "signals": {r: {"column": ex.data.columns.get(r, r), "unit": ex.data.unit(r)} for r in ex.data.signals},
         "settings": ex.settings,
         "plain": {"errors": _errors(ex.plain.errors), "bic": ex.plain.bic, "aic": ex.plain.aic},
+        "declared_refit": {"errors": _errors(ex.base.errors), "bic": ex.base.bic, "parameters": ex.base.parameters()},
+        "declared": [{"name": c.name, "effect": c.key, "declared": c.declared, "fitted": c.fitted,
+                      "supported": c.supported, "held_out_rmse_with": c.held_out_rmse_with,
+                      "held_out_rmse_without": c.held_out_rmse_without, "text": c.text()} for c in ex.declared],
         "steps": [
             {"effect": s.effect, "parameters": s.after.parameters(),
              "errors_before": _errors(s.before.errors), "errors_after": _errors(s.after.errors),
              "bic_before": s.before.bic, "bic_after": s.after.bic,
+             "ambiguous_with": None if s.alternative is None else
+             {"effect": s.alternative.effect, "held_out_rmse": s.alternative.held_out_rmse,
+              "parameters": s.alternative.fit.parameters()[s.alternative.effect]},
              "trace": [_trace_row(t) for t in s.trace]}
             for s in ex.steps
         ],
         "last_trace": [_trace_row(t) for t in ex.last_trace],
-        "final": {"effects": ex.found, "parameters": ex.final.parameters(), "errors": _errors(ex.final.errors)},
+        "final": {"effects": ex.found, "unsupported": ex.unsupported, "ambiguities": [list(a) for a in ex.ambiguities],
+                  "converged": ex.final.converged, "parameters": ex.final.parameters(),
+                  "errors": _errors(ex.final.errors)},
         "residual_tests_before": ex.tests_before,
         "residual_tests": ex.tests_after,
         "verdict": ex.verdict(),
@@ -62,7 +71,7 @@ def plots(ex: Explanation, out_dir: Path, stem: str, loop_plot: bool) -> list[Pa
     step = max(1, d.n // 5000)
     for ax, role in zip(axes[:, 0], roles):
         x = d.signals[role][::step]
-        ax.plot(x, before[::step], ".", ms=1.5, alpha=0.5, label="before (plain model)")
+        ax.plot(x, before[::step], ".", ms=1.5, alpha=0.5, label="before (declared model)")
         ax.plot(x, after[::step], ".", ms=1.5, alpha=0.5, label="after")
         ax.set_xlabel(f"{role}: {d.columns.get(role, role)} ({d.unit(role)})")
         ax.set_ylabel(f"residual ({d.measured_unit})")
@@ -75,7 +84,7 @@ def plots(ex: Explanation, out_dir: Path, stem: str, loop_plot: bool) -> list[Pa
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
     t = d.time
     a1.plot(t, d.measured, lw=0.8, label="measured")
-    a1.plot(t, ex.plain.prediction, lw=0.8, label="plain model")
+    a1.plot(t, ex.plain.prediction, lw=0.8, label="declared model")
     a1.plot(t, ex.final.prediction, lw=0.8, label="model + " + (", ".join(ex.found) or "nothing"))
     a1.set_ylabel(f"{d.measured_name} ({d.measured_unit})")
     a1.legend(loc="best", fontsize=7)
@@ -90,13 +99,13 @@ def plots(ex: Explanation, out_dir: Path, stem: str, loop_plot: bool) -> list[Pa
     fig.savefig(files[-1], dpi=90)
     plt.close(fig)
 
-    if loop_plot and "displacement" in d.signals:
+    if loop_plot and "deflection" in d.signals:
         fig, ax = plt.subplots(figsize=(5, 4))
-        x = d.signals["displacement"]
+        x = d.signals["deflection"]
         ax.plot(x[::step], d.measured[::step], ".", ms=1.5, label="measured")
-        ax.plot(x, ex.plain.prediction, lw=1, label="plain model")
+        ax.plot(x, ex.plain.prediction, lw=1, label="declared model")
         ax.plot(x, ex.final.prediction, lw=0.8, label="fitted model")
-        ax.set_xlabel(f"{d.columns.get('displacement', 'displacement')} ({d.unit('displacement')})")
+        ax.set_xlabel(f"{d.columns.get('deflection', 'deflection')} ({d.unit('deflection')})")
         ax.set_ylabel(f"{d.measured_name} ({d.measured_unit})")
         ax.legend(loc="best", fontsize=7, markerscale=6)
         fig.tight_layout()
@@ -120,16 +129,29 @@ def markdown(report: dict[str, Any], images: list[Path]) -> str:
              f"training BIC by >= {report['settings']['min_bic_drop']:g}.", "",
              "## Error before and after", "", f"| model | train RMSE ({u}) | held-out RMSE ({u}) | held-out peak ({u}) | held-out fit % |",
              "|---|---|---|---|---|"]
-    rows = [("plain", report["plain"]["errors"])] + [(f"+ {s['effect']}", s["errors_after"]) for s in report["steps"]]
+    rows = [("declared model as given", report["plain"]["errors"]),
+            ("declared model refitted", report["declared_refit"]["errors"])] + \
+        [(f"+ {s['effect']}", s["errors_after"]) for s in report["steps"]] + [("final", report["final"]["errors"])]
     for name, e in rows:
         lines.append(f"| {name} | {_fmt(e['train']['rmse'])} | {_fmt(e['held_out']['rmse'])} | "
                      f"{_fmt(e['held_out']['peak'])} | {e['held_out']['fit_percent']:.2f} |")
+    if report["declared"]:
+        lines += ["", "## Declared model: declared values against what the data says", ""]
+        lines += [f"- {c['text']}" for c in report["declared"]]
+    if not report["final"]["converged"]:
+        lines += ["", "**The final fit did not converge (least_squares stopped at its evaluation limit); its "
+                      "numbers are not a result.**"]
     for i, s in enumerate(report["steps"], 1):
-        lines += ["", f"## Step {i}: {s['effect']}", "", "| effect | parameter | value | uncertainty (1 sigma) | unit |",
-                  "|---|---|---|---|---|"]
+        lines += ["", f"## Step {i}: {s['effect']}", ""]
+        if s["ambiguous_with"]:
+            a = s["ambiguous_with"]
+            lines += [f"Ambiguous: {a['effect']} fits as well (held-out RMSE {_fmt(a['held_out_rmse'])} {u}) and adds "
+                      f"nothing beside {s['effect']}; the data cannot tell them apart. Its fit: "
+                      + ", ".join(f"{n} = {_fmt(p['value'])} {p['unit']}" for n, p in a["parameters"].items()), ""]
+        lines += ["| effect | parameter | value | uncertainty (1 sigma) | unit |", "|---|---|---|---|---|"]
         for eff, ps in s["parameters"].items():
             for name, p in ps.items():
-                bound = " (at search bound)" if p["at_bound"] else ""
+                bound = " (at search bound)" if p["at_bound"] else " (held)" if p["held"] else ""
                 lines.append(f"| {eff} | {name} | {_fmt(p['value'])}{bound} | {_fmt(p['uncertainty'])} | {p['unit']} |")
         lines += ["", f"Candidates tried (held-out RMSE {u}, BIC):", "",
                   "| candidate | held-out RMSE | BIC | accepted | parameter at search bound |", "|---|---|---|---|---|"]

@@ -16,6 +16,7 @@ from seadesign.effects import (
     DahlHysteresis,
     DeadBand,
     EffectChain,
+    EffortLag,
     Friction,
     GravityLoad,
     LinearSpring,
@@ -24,6 +25,7 @@ from seadesign.effects import (
     SensorDrift,
     SensorNoise,
     SensorOffset,
+    SensorStep,
     StanceLoad,
     StiffnessScale,
     ThermalSoftening,
@@ -32,6 +34,9 @@ from seadesign.effects import (
 from seadesign.constants import G_M_PER_S2
 from seadesign.errors import ConfigError
 
+#: Coulomb friction of the gearbox in the servo's effort (Nm): the thesis's servo reports torque
+#: before it reaches the horn; 0.3 Nm is our estimate (DOMAIN.md), declared by the loop's robot model.
+GEAR_COULOMB_NM = 0.3
 
 
 @dataclass(frozen=True)
@@ -103,7 +108,8 @@ class KneeConfig:
 def knee_effects(cfg: KneeConfig, ground: bool = False) -> EffectChain:
     """The knee simulator's effect chain; on by default: backlash, spring, gravity, friction,
     ground contact (when `ground`), gear friction in the effort, sensor noise and 12-bit
-    quantisation. Everything else is declared but off; switch with `EffectChain.configure`.
+    quantisation. Everything else is declared but off (among them a Hall step and the effort's lag);
+    switch with `EffectChain.configure`.
     """
     return EffectChain([
         DeadBand("backlash", width_rad=cfg.backlash_rad),
@@ -120,13 +126,15 @@ def knee_effects(cfg: KneeConfig, ground: bool = False) -> EffectChain:
                    upper_leg_m=cfg.upper_leg_m, lower_leg_m=cfg.lower_leg_m),
         SensorDelay("hall_delay", enabled=False),
         SensorOffset("hall_offset", enabled=False),
+        SensorStep("hall_step", enabled=False),
         SensorDrift("hall_drift", enabled=False),
         SensorNoise("hall_noise", std_rad=0.002),
         Quantisation("hall_quantisation", bits=12),
         AngleWrap("hall_wrap", enabled=False),
         Quantisation("motor_quantisation", bind={"hall": "motor"}, bits=12),
         Friction("gear_friction", bind={"velocity": "motor_velocity", "load_torque": "effort"},
-                 coulomb_Nm=0.3, viscous_Nm_s_per_rad=0.0),
+                 coulomb_Nm=GEAR_COULOMB_NM, viscous_Nm_s_per_rad=0.0),
+        EffortLag("effort_lag", enabled=False),
         SensorNoise("effort_noise", bind={"hall": "effort"}, std_rad=0.05),
     ])
 
@@ -145,6 +153,7 @@ def bench_effects(k_Nm_per_rad: float) -> EffectChain:
         Friction("friction", enabled=False, bind={"velocity": "deflection_rate", "load_torque": "torque"}),
         SensorDelay("hall_delay", enabled=False),
         SensorOffset("hall_offset", enabled=False),
+        SensorStep("hall_step", enabled=False),
         SensorDrift("hall_drift", enabled=False),
         SensorNoise("hall_noise", std_rad=0.001),
         Quantisation("hall_quantisation", enabled=False, bits=12),

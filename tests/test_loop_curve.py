@@ -1,0 +1,52 @@
+"""The large-deflection torque curve as the loop's spring (spring.json `torque_curve`) instead of k."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from helpers_generators import K, robot
+from seadesign.effects import CurveRangeError
+from seadesign.loop import explain
+from seadesign.loop.sea import robot_loop_data
+
+K3 = -80.0  # the generator's spring softens: T = k d + K3 d^3 (monotone up to 0.19 rad)
+
+
+def curve(end_rad: float, hard_stop: bool = False) -> dict:
+    theta = np.linspace(0.0, end_rad, 7)
+    return {"rotation_rad": theta.tolist(), "torque_Nm": (K * theta + K3 * theta ** 3).tolist(),
+            "source": "fea_large_deflection", "stop_reason": "limit_point", "hard_stop": hard_stop}
+
+
+@pytest.fixture(scope="module")
+def softening_knee():
+    return robot({"cubic_stiffening": {"k3_Nm_per_rad3": K3}}, seed=50)
+
+
+def test_a_schema_2_spring_json_with_the_curve_loads_and_is_the_models_spring(tmp_path, spring_dict):
+    from seadesign.design.spring import load_spring, write_spring
+    from seadesign.effects import SpringCurve
+    from seadesign.loop.sea import model_spring
+
+    path = write_spring({**spring_dict, "schema_version": 2, "torque_curve": curve(0.17)}, tmp_path / "spring.json")
+    spring = model_spring(load_spring(path))
+    assert isinstance(spring, SpringCurve) and spring.curve.end_rotation_rad == pytest.approx(0.17)
+
+
+def test_curve_is_the_spring_and_explains_the_softening(spring_dict, softening_knee):
+    linear = explain(robot_loop_data(softening_knee, spring_dict), [], max_steps=1)
+    assert linear.found == ["cubic_stiffening"], linear.verdict()
+    assert linear.final.parameters()["cubic_stiffening"]["k3_Nm_per_rad3"]["value"] == pytest.approx(K3, rel=0.05)
+    with_curve = explain(robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.17)}), [], max_steps=1)
+    assert with_curve.found == [], with_curve.verdict()
+    # the curve (7 PCHIP points) predicts as well as the fitted cubic, from the start
+    assert with_curve.plain.errors["held_out"]["rmse"] < 1.05 * linear.final.errors["held_out"]["rmse"]
+    assert with_curve.final.parameters()["stiffness_scale"]["scale"]["value"] == pytest.approx(1.0, abs=0.01)
+
+
+def test_data_past_the_curve_is_refused_not_extrapolated(spring_dict, softening_knee):
+    with pytest.raises(CurveRangeError, match=r"past the spring's torque curve: the curve ends at 0\.05 rad"):
+        explain(robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.05)}), [])
+    stop = robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.05, hard_stop=True)})
+    assert stop.n == len(softening_knee)  # a hard stop holds the rotation at the end instead

@@ -1,0 +1,56 @@
+"""The loop on the real recordings (`../shared/data/deepsea/`): the README's table of findings, held here.
+
+Each row: `seadesign explain FILE --spring spring_measured.json --knee l|r` (the thesis's measured spring,
+k = 9.106 Nm/rad; the default declared chain: backlash and gear friction; the data module's cleaning): the
+effects named in order, the declared effects the data does not support, and the held-out RMSE before (the
+declared model as given) and after, to 1 % (the engine is deterministic; the margin is for floating point
+across machines). When the code changes an answer this test fails, and the README is updated on purpose: the
+rows are also checked against the README's table.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from conftest import shared_path
+from seadesign.data import clean, is_hanging, read_recording
+from seadesign.loop import explain
+from seadesign.loop.sea import robot_declared, robot_loop_data
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+# (file, knee): (named effects in order, unsupported declared effects, held-out RMSE before, after (rad))
+ROWS = {
+    ("free_dtest_part1", "l"): (["stiffness_scale", "sensor_drift"], ["backlash", "gear_friction"], 0.1119, 0.08433),
+    ("free_dtest_part1", "r"): (["stiffness_scale", "sensor_delay", "hysteresis"], ["backlash"], 0.1601, 0.07468),
+    ("ground_dtest_part1", "l"): (["sensor_offset", "sensor_step", "sensor_step_2", "hysteresis"], ["backlash"],
+                                  1.483, 0.0992),
+    ("ground_dtest_part1", "r"): (["stiffness_scale", "sensor_offset", "hysteresis", "sensor_step", "sensor_step_2"],
+                                  ["backlash", "gear_friction"], 1.093, 0.1311),
+    ("d1free", "l"): (["stiffness_scale"], ["backlash", "gear_friction"], 0.01644, 0.005232),
+    ("d1free", "r"): (["stiffness_scale"], ["backlash", "gear_friction"], 0.04526, 0.003184),
+}
+
+
+def readme_row(name: str, knee: str) -> str:
+    found, unsupported, before, after = ROWS[(name, knee)]
+    return (f"| {name}, {'left' if knee == 'l' else 'right'} | {', '.join(found)} | {', '.join(unsupported) or '-'} "
+            f"| {before:.4g} -> {after:.4g} |")
+
+
+@pytest.mark.slow
+@pytest.mark.shared
+@pytest.mark.parametrize("name, knee", list(ROWS), ids=[f"{n}-{k}" for n, k in ROWS])
+def test_real_recording_findings_are_the_readmes(spring_dict, name, knee):
+    raw = read_recording(shared_path("data", "deepsea", f"{name}.csv"))
+    table = clean(raw, keep_lifted=is_hanging(raw), normalise=False, euler=False).table
+    ex = explain(robot_loop_data(table, spring_dict, knee), robot_declared(spring_dict))
+    found, unsupported, before, after = ROWS[(name, knee)]
+    assert ex.found == found, ex.verdict()
+    assert ex.unsupported == unsupported
+    assert ex.plain.errors["held_out"]["rmse"] == pytest.approx(before, rel=0.01)
+    assert ex.final.errors["held_out"]["rmse"] == pytest.approx(after, rel=0.01)
+    assert ex.final.converged
+    assert readme_row(name, knee) in README.read_text(), "update the README's table to the test's rows"
