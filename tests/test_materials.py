@@ -67,3 +67,30 @@ def test_unknown_material_lists_known():
 def test_toml_syntax_error(tmp_path):
     with pytest.raises(ConfigError, match="not valid TOML"):
         load_material_file(_write(tmp_path, "name = "))
+
+
+def test_allowable_strain_and_the_derived_hyperelastic_law():
+    nf = load_material("ninjaflex")
+    assert nf.elongation_at_yield == pytest.approx(0.65)
+    assert nf.allowable_strain(1.5) == pytest.approx(0.65 / 1.5)
+    assert load_material("cheetah").allowable_strain(1.5) is None  # no sourced value: cannot be judged
+    law = nf.law  # DOMAIN.md: E 12 MPa, nu 0.48 -> C10 = mu / 2 = 2.03 MPa, D1 = 2 / K = 0.020 1/MPa
+    assert law.model == "neo_hooke"
+    assert law.c10_Pa == pytest.approx(12e6 / (2 * 1.48) / 2)
+    assert law.d1_per_Pa == pytest.approx(2 / (12e6 / (3 * (1 - 0.96))))
+    soft = nf.scaled(0.5, "test").law
+    assert soft.c10_Pa == pytest.approx(law.c10_Pa / 2) and soft.d1_per_Pa == pytest.approx(law.d1_per_Pa * 2)
+
+
+def test_a_hyperelastic_table_is_read_in_si_and_checked(tmp_path):
+    text = GOOD + ('hyperelastic = { model = "mooney_rivlin", source = "test fit", c10 = { value = 1.5, unit = "MPa" }, '
+                   'c01 = { value = 0.3, unit = "MPa" }, d1 = { value = 0.02, unit = "1/MPa" } }\n')
+    m = load_material_file(_write(tmp_path, text))
+    assert (m.law.model, m.law.c10_Pa, m.law.c01_Pa, m.law.d1_per_Pa) == ("mooney_rivlin", 1.5e6, 0.3e6, 2e-8)
+    assert m.scaled(2.0, "x").law.c01_Pa == pytest.approx(0.6e6)
+    with pytest.raises(ConfigError, match="hyperelastic.model.*'ogden' is not a known model"):
+        load_material_file(_write(tmp_path, GOOD + 'hyperelastic = { model = "ogden", source = "x" }\n'))
+    with pytest.raises(ConfigError, match="hyperelastic.c01 is missing"):
+        load_material_file(_write(tmp_path, text.replace('c01 = { value = 0.3, unit = "MPa" }, ', '')))
+    with pytest.raises(ConfigError, match="elongation_at_yield.unit"):
+        load_material_file(_write(tmp_path, GOOD + 'elongation_at_yield = { value = 65, unit = "percent", source = "x" }\n'))

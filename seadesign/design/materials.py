@@ -1,12 +1,18 @@
 """Material files (`materials/*.toml`): loading, unit conversion to SI, validation.
 
 Each property is a table `{ value = ..., unit = "...", source = "..." }`; the loader converts
-to SI (Pa, kg/m^3) and rejects anything missing, non-numeric or outside a physical range.
+to SI (Pa, kg/m^3, 1/Pa, strain as a fraction) and rejects anything missing, non-numeric or
+outside a physical range. Two optional entries serve the large-deflection analysis:
+`elongation_at_yield` (the allowable strain's basis, with its source; without it the strain
+requirement cannot be judged and results say so), and `hyperelastic`, the finite-strain law in
+CalculiX's form (`model = "neo_hooke" | "mooney_rivlin" | "yeoh"` with its constants and a
+source). Without `hyperelastic`, a neo-Hookean law is derived from E and nu (C10 = mu / 2,
+D1 = 2 / K), so the small-strain limit is exactly the linear model.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from seadesign.design.tomlcheck import Table, find_toml, read_toml
@@ -16,6 +22,14 @@ MATERIALS_DIR = Path(__file__).resolve().parents[2] / "materials"
 _TO_PA = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
 _TO_KG_M3 = {"kg/m^3": 1.0, "kg/m3": 1.0, "g/cc": 1000.0, "g/cm^3": 1000.0, "g/cm3": 1000.0}
 _DIMENSIONLESS = {"-": 1.0, "1": 1.0}
+_STRAIN = {"%": 0.01, "-": 1.0}
+_PER_PA = {"1/Pa": 1.0, "1/kPa": 1e-3, "1/MPa": 1e-6}
+# the constants of each hyperelastic model (CalculiX *HYPERELASTIC): name -> unit table
+HYPERELASTIC_MODELS = {
+    "neo_hooke": ("c10", "d1"),
+    "mooney_rivlin": ("c10", "c01", "d1"),
+    "yeoh": ("c10", "c20", "c30", "d1", "d2", "d3"),
+}
 
 # (key, unit table, SI range (lo, hi), range is exclusive)
 _FIELDS = {
@@ -25,6 +39,30 @@ _FIELDS = {
     "yield_strength": (_TO_PA, (1e4, 1e10)),
     "tensile_strength": (_TO_PA, (1e4, 1e10)),
 }
+
+
+@dataclass(frozen=True)
+class Hyperelastic:
+    """A finite-strain law in CalculiX's form: W = sum Cij (I1bar - 3)^i (I2bar - 3)^j + sum (J - 1)^(2k) / Dk.
+    Moduli in Pa, compressibilities in 1/Pa (0: term absent); `source` says where they come from."""
+
+    model: str  # "neo_hooke", "mooney_rivlin" or "yeoh"
+    c10_Pa: float
+    d1_per_Pa: float
+    source: str
+    c01_Pa: float = 0.0
+    c20_Pa: float = 0.0
+    c30_Pa: float = 0.0
+    d2_per_Pa: float = 0.0
+    d3_per_Pa: float = 0.0
+
+    @classmethod
+    def from_linear(cls, youngs_modulus_Pa: float, poisson_ratio: float) -> "Hyperelastic":
+        """The neo-Hookean law whose small-strain limit is the linear model (E, nu)."""
+        mu = youngs_modulus_Pa / (2.0 * (1.0 + poisson_ratio))
+        bulk = youngs_modulus_Pa / (3.0 * (1.0 - 2.0 * poisson_ratio))
+        return cls("neo_hooke", c10_Pa=mu / 2.0, d1_per_Pa=2.0 / bulk,
+                   source="derived from E and nu: C10 = mu / 2, D1 = 2 / K (small-strain limit = the linear model)")
 
 
 @dataclass(frozen=True)
@@ -39,18 +77,31 @@ class Material:
     yield_strength_Pa: float
     tensile_strength_Pa: float
     sources: tuple[tuple[str, str], ...]  # (property, source) pairs
+    hyperelastic: Hyperelastic | None = None  # None: derived from E and nu (see `law`)
+    elongation_at_yield: float | None = None  # engineering strain (0.65 = 65 %); None: no sourced value
+
+    @property
+    def law(self) -> Hyperelastic:
+        """The finite-strain law: the file's, or the neo-Hookean one derived from E and nu."""
+        return self.hyperelastic or Hyperelastic.from_linear(self.youngs_modulus_Pa, self.poisson_ratio)
+
+    def allowable_strain(self, safety_factor: float) -> float | None:
+        """Allowable engineering strain: elongation at yield / safety factor (None when unsourced)."""
+        return None if self.elongation_at_yield is None else self.elongation_at_yield / safety_factor
 
     @property
     def shear_modulus_Pa(self) -> float:
         return self.youngs_modulus_Pa / (2.0 * (1.0 + self.poisson_ratio))
 
     def scaled(self, stiffness_scale: float, note: str) -> "Material":
-        """The same material with E multiplied by `stiffness_scale` (a calibration result)."""
-        data = asdict(self)
-        data["youngs_modulus_Pa"] = self.youngs_modulus_Pa * stiffness_scale
-        data["name"] = f"{self.name} ({note})"
-        data["sources"] = tuple(tuple(s) for s in self.sources) + (("youngs_modulus", note),)
-        return Material(**data)
+        """The same material with every modulus multiplied by `stiffness_scale` (a calibration result)."""
+        h, s = self.hyperelastic, stiffness_scale
+        hyper = None if h is None else replace(
+            h, c10_Pa=h.c10_Pa * s, c01_Pa=h.c01_Pa * s, c20_Pa=h.c20_Pa * s, c30_Pa=h.c30_Pa * s,
+            d1_per_Pa=h.d1_per_Pa / s, d2_per_Pa=h.d2_per_Pa / s, d3_per_Pa=h.d3_per_Pa / s,
+            source=f"{h.source}; x {s:.4g} ({note})")
+        return replace(self, youngs_modulus_Pa=self.youngs_modulus_Pa * s, name=f"{self.name} ({note})",
+                       sources=tuple(tuple(x) for x in self.sources) + (("youngs_modulus", note),), hyperelastic=hyper)
 
     def to_handoff(self) -> dict:
         """The material block of spring.json."""
@@ -78,6 +129,29 @@ def _quantity(top: Table, field: str, units: dict[str, float], lo: float, hi: fl
     return si, source
 
 
+def _hyperelastic(top: Table) -> Hyperelastic | None:
+    sub = top.table("hyperelastic", optional=True)
+    if sub is None:
+        return None
+    model = sub.string("model")
+    if model not in HYPERELASTIC_MODELS:
+        raise sub.error(sub.key("model"), f"'{model}' is not a known model; use one of {', '.join(HYPERELASTIC_MODELS)}")
+    constants = {}
+    for name in HYPERELASTIC_MODELS[model]:
+        units = _PER_PA if name.startswith("d") else _TO_PA
+        c = sub.table(name)
+        value, unit = c.number("value"), c.string("unit")
+        c.done()
+        if unit not in units:
+            raise c.error(c.key("unit"), f"'{unit}' is not a known unit here; use one of {', '.join(units)}")
+        constants[f"{name}_{'per_Pa' if name.startswith('d') else 'Pa'}"] = value * units[unit]
+    source = sub.string("source")
+    sub.done()
+    if not constants["c10_Pa"] > 0 or not constants["d1_per_Pa"] > 0:
+        raise sub.error(sub.key("c10"), "and d1 must be positive (a stable material in the small-strain limit)")
+    return Hyperelastic(model, source=source, **constants)
+
+
 def load_material_file(path: str | Path) -> Material:
     """Load and validate one material file."""
     path = Path(path)
@@ -88,6 +162,11 @@ def load_material_file(path: str | Path) -> Material:
     for field, (units, (lo, hi)) in _FIELDS.items():
         values[field], src = _quantity(top, field, units, lo, hi)
         sources.append((field, src))
+    elongation = None
+    if "elongation_at_yield" in top.data:
+        elongation, src = _quantity(top, "elongation_at_yield", _STRAIN, 0.0, 20.0)
+        sources.append(("elongation_at_yield", src))
+    hyper = _hyperelastic(top)
     top.done()
     return Material(
         key=path.stem,
@@ -98,6 +177,8 @@ def load_material_file(path: str | Path) -> Material:
         yield_strength_Pa=values["yield_strength"],
         tensile_strength_Pa=values["tensile_strength"],
         sources=tuple(sources),
+        hyperelastic=hyper,
+        elongation_at_yield=elongation,
     )
 
 
