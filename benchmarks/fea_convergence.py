@@ -39,7 +39,7 @@ def k_at(st, part, width, refinement, backend, cache_dir) -> tuple[float, float,
     m, lc = st.material, st.load_cases
     r = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, lc.stall_torque_Nm,
                 lc.impact_torque_Nm, st.bearing_radius_mm).results
-    return r.k_Nm_per_rad, r.stall.von_mises_max.MPa, len(mesh.tets), time.perf_counter() - t
+    return r.k_Nm_per_rad, r.stall.stresses.von_mises_max.MPa, len(mesh.tets), time.perf_counter() - t
 
 
 def main() -> None:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from seadesign.errors import SolverError
-from seadesign.fea.results import ImpactResult, LinearResults, SolveStats, StallResult, StressPeak
+from seadesign.fea.results import ImpactResult, LinearResults, PeakStresses, SolveStats, StallResult, StressPeak
 from seadesign.fea.stress import invariants, project_to_nodes, vertex_stresses
 from seadesign.fea.torsion import MM, UnitTorsion, solve_unit_torsion
 from seadesign.mesh.tetmesh import TetMesh
@@ -49,8 +49,8 @@ class Analysis:
         return m[:3] + np.cross(m[3:], d)
 
 
-def _stress_peaks(voigt_Pa: np.ndarray, nodes_mm: np.ndarray) -> dict[str, StressPeak]:
-    """Peak of each STRESS_NAMES measure (the minimum of principal_3) and where it is."""
+def _stress_peaks(voigt_Pa: np.ndarray, nodes_mm: np.ndarray, yield_strength_Pa: float) -> PeakStresses:
+    """Peak of each STRESS_NAMES measure (the minimum of principal_3), where it is, and the safety factor."""
     inv = invariants(voigt_Pa)
     out = {}
     for name in STRESS_NAMES:
@@ -58,7 +58,7 @@ def _stress_peaks(voigt_Pa: np.ndarray, nodes_mm: np.ndarray) -> dict[str, Stres
         i = int(np.argmin(field)) if name == "principal_3" else int(np.argmax(field))
         x, y, z = (float(c) for c in nodes_mm[i])
         out[f"{name}_{'min' if name == 'principal_3' else 'max'}"] = StressPeak(float(field[i] * 1e-6), x, y, z)
-    return out
+    return PeakStresses(**out, safety_factor=yield_strength_Pa / (out["von_mises_max"].MPa * 1e6))
 
 
 def _results(unit: UnitTorsion, stress_per_Nm: np.ndarray, torque: dict[str, float], yield_strength_Pa: float,
@@ -81,15 +81,13 @@ def _results(unit: UnitTorsion, stress_per_Nm: np.ndarray, torque: dict[str, flo
     peak_nodal = float(np.linalg.norm(f[hub_nodes], axis=1).max())
 
     t_stall, t_impact = torque["stall"], -torque["impact"]
-    peaks = {case: _stress_peaks(stress_per_Nm * t, nodes_mm) for case, t in torque.items()}
-    stall = StallResult(
-        torque_Nm=t_stall, rotation_rad=t_stall * theta, bearing_displacement_mm=t_stall * bearing_per_Nm / MM,
-        **peaks["stall"], safety_factor=yield_strength_Pa / (peaks["stall"]["von_mises_max"].MPa * 1e6))
+    stresses = {case: _stress_peaks(stress_per_Nm * t, nodes_mm, yield_strength_Pa) for case, t in torque.items()}
+    stall = StallResult(torque_Nm=t_stall, rotation_rad=t_stall * theta,
+                        bearing_displacement_mm=t_stall * bearing_per_Nm / MM, stresses=stresses["stall"])
     impact = ImpactResult(
         torque_Nm=t_impact, reaction_per_bolt_N=t_impact * float(max(bolt)),
         reaction_per_bolt_min_N=t_impact * float(min(bolt)), bolt_count=float(len(bolt)),
-        peak_nodal_reaction_N=t_impact * peak_nodal, **peaks["impact"],
-        safety_factor=yield_strength_Pa / (peaks["impact"]["von_mises_max"].MPa * 1e6))
+        peak_nodal_reaction_N=t_impact * peak_nodal, stresses=stresses["impact"])
     return LinearResults(k_Nm_per_rad=1.0 / theta, equilibrium_rel_error=equilibrium, stall=stall, impact=impact,
                          stats=stats)
 

@@ -50,17 +50,24 @@ class StressPeak:
 
 
 @dataclass(frozen=True)
+class PeakStresses:
+    """The peak stresses of one load case, and the safety factor against yield they give."""
+
+    von_mises_max: StressPeak = nested()
+    principal_1_max: StressPeak = nested()
+    principal_3_min: StressPeak = nested()
+    max_shear_max: StressPeak = nested()
+    safety_factor: float = inverse()  # yield strength / peak von Mises
+
+
+@dataclass(frozen=True)
 class StallResult:
     """Stall torque on the hub, ring held."""
 
     torque_Nm: float = linear()
     rotation_rad: float = linear()
     bearing_displacement_mm: float = linear()  # largest displacement on the bearing circle
-    von_mises_max: StressPeak = nested()
-    principal_1_max: StressPeak = nested()
-    principal_3_min: StressPeak = nested()
-    max_shear_max: StressPeak = nested()
-    safety_factor: float = inverse()  # yield strength / peak von Mises
+    stresses: PeakStresses = nested("")
 
 
 @dataclass(frozen=True)
@@ -72,11 +79,7 @@ class ImpactResult:
     reaction_per_bolt_min_N: float = linear()
     bolt_count: float = unscaled()
     peak_nodal_reaction_N: float = linear()  # largest single nodal force (mesh dependent)
-    von_mises_max: StressPeak = nested()
-    principal_1_max: StressPeak = nested()
-    principal_3_min: StressPeak = nested()
-    max_shear_max: StressPeak = nested()
-    safety_factor: float = inverse()
+    stresses: PeakStresses = nested("")
 
 
 @dataclass(frozen=True)
@@ -109,7 +112,7 @@ class LinearResults:
     @property
     def safety_factor(self) -> float:
         """The smaller of the two load cases' safety factors (yield / peak von Mises)."""
-        return min(self.stall.safety_factor, self.impact.safety_factor)
+        return min(self.stall.stresses.safety_factor, self.impact.stresses.safety_factor)
 
     def columns(self) -> dict[str, float]:
         """The results table's columns of this solve (see `columns`), with the overall safety factor."""
