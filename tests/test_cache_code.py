@@ -66,3 +66,27 @@ def test_fingerprint_follows_imports_inside_functions_and_parent_packages():
     assert code_fingerprint("seadesign.design.candidate") != code_fingerprint("seadesign.design.geometry")
     with pytest.raises(ValueError, match="not a module"):
         code_fingerprint("seadesign.no_such_module")
+
+
+def test_a_stored_row_is_keyed_on_the_code_that_builds_its_columns(tmp_path, monkeypatch):
+    # the row's derived columns (k's error estimate, rotations in degrees, ...) come from sweep/table.py:
+    # editing it must give new row keys, while the geometry stage's key stays
+    from seadesign.design.study import load_study
+    from seadesign.run import fingerprint
+    from seadesign.sweep.runner import row_key
+    from seadesign.sweep.stages import SolverSettings, geometry_key
+
+    study = load_study(write_tiny_study(tmp_path))
+    cand, settings = study.candidates()[0], SolverSettings()
+    before = row_key(study, cand, settings), geometry_key(study, cand)
+    table = fingerprint.module_path("seadesign.sweep.table")
+    real = Path.read_bytes
+    monkeypatch.setattr(Path, "read_bytes", lambda p: real(p) + (b"\n# edited\n" if p == table else b""))
+    fingerprint.code_fingerprint.cache_clear()
+    try:
+        after = row_key(study, cand, settings), geometry_key(study, cand)
+    finally:
+        monkeypatch.undo()
+        fingerprint.code_fingerprint.cache_clear()
+    assert after[0] != before[0]
+    assert after[1] == before[1]

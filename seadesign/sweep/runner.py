@@ -23,6 +23,7 @@ import pandas as pd
 
 from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
+from seadesign.run.fingerprint import code_fingerprint
 from seadesign.run.atomic import atomic_write
 from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.executors import default_jobs, execute
@@ -64,9 +65,10 @@ class SweepRun:
 
 def row_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
     """Hash of every input of one candidate's row (its axis values, geometry, mesh, material, loads,
-    solver, versions)."""
+    solver, versions) and of the code that turns the stage outputs into the row (this module and
+    the table's columns)."""
     return digest("row", candidate.values, fea_key(study, candidate, settings), geometry_key(study, candidate),
-                  study.load_cases, study.bearing_radius_mm, candidate.material)
+                  study.load_cases, study.bearing_radius_mm, candidate.material, code_fingerprint(__name__))
 
 
 def evaluate(job: Job, sink) -> dict:
