@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import click
 
+from seadesign import constants as C
 from seadesign.cli import main
 from seadesign.data import (
     clean,
@@ -145,8 +147,11 @@ def simulate_bench_cmd(spring_path: Path, profile: str, torque_amplitude_nm: flo
 @click.option("--bench", is_flag=True, help="List the bench simulator's chain instead of the knee's.")
 def effects_cmd(bench: bool) -> None:
     """List the simulator's effects: name, on/off, parameters with units and bounds."""
-    cfg = KneeConfig(k_Nm_per_rad=9.106, stall_torque_Nm=11.7, no_load_speed_rad_per_s=4.817, backlash_rad=0.00436,
-                     mass_kg=8.0, lower_leg_m=0.2038, upper_leg_m=0.2)
+    # the thesis's robot and servo, the measured k; the upper leg assumed equal to the lower (as the default study)
+    cfg = KneeConfig(k_Nm_per_rad=C.THESIS_K_MEASURED_NM_PER_RAD, stall_torque_Nm=C.XH540_STALL_TORQUE_NM,
+                     no_load_speed_rad_per_s=C.XH540_NO_LOAD_SPEED_RPM * 2 * math.pi / 60,
+                     backlash_rad=math.radians(C.XH540_BACKLASH_DEG), mass_kg=C.WOLFGANG_MASS_KG,
+                     lower_leg_m=C.WOLFGANG_LOWER_LEG_M, upper_leg_m=C.WOLFGANG_LOWER_LEG_M)
     chain: EffectChain = bench_effects(cfg.k_Nm_per_rad) if bench else knee_effects(cfg)
     for e in chain:
         click.echo(f"{e.name:20s} {'on ' if e.enabled else 'off'}  {e.summary}  [{e.key}: {' -> '.join([*map(e.signal, e.reads), e.target()])}]")

@@ -14,7 +14,8 @@ from seadesign.design.spring import load_spring
 from seadesign.loop import CANDIDATES, ROLES, explain, from_frame
 from seadesign.loop.report import write_report
 from seadesign.loop.sea import ROBOT_DECLARED, bench_loop_data, calibration, robot_declared, robot_loop_data
-from seadesign.loop.thesis import K_FEA_NM_PER_RAD, K_MEASURED_NM_PER_RAD, worked_example
+from seadesign.constants import THESIS_K_MEASURED_NM_PER_RAD
+from seadesign.loop.thesis import K_FEA_NM_PER_RAD, worked_example
 
 #: older role names the generic table's --signal still accepts (the loop's vocabulary is the effect library's)
 ROLE_ALIASES = {"displacement": "deflection"}
@@ -134,7 +135,7 @@ def explain_cmd(file: Path, spring_path: Path | None, json_out: Path | None, out
 def explain_thesis_cmd(spring_path: Path, out_dir: Path, seed: int) -> None:
     """Worked thesis example: FEA k (generic TPU) vs a bench file simulated from the measured k with a dead-band."""
     ex, cal = worked_example(load_spring(spring_path), out_dir, seed)
-    click.echo(f"model k {K_FEA_NM_PER_RAD:.4g} Nm/rad (thesis FEA), bench simulated with k {K_MEASURED_NM_PER_RAD} Nm/rad")
+    click.echo(f"model k {K_FEA_NM_PER_RAD:.4g} Nm/rad (thesis FEA), bench simulated with k {THESIS_K_MEASURED_NM_PER_RAD} Nm/rad")
     click.echo(ex.verdict())
     for key, ps in ex.final.parameters().items():
         click.echo(f"  {key}: " + ", ".join(f"{n} = {p['value']:.4g} +- {p['uncertainty']:.2g} {p['unit']}"

@@ -15,6 +15,7 @@ import numpy as np
 from scipy.signal import lfilter, lfilter_zi
 from scipy.special import erf
 
+from seadesign.constants import THESIS_K_MEASURED_NM_PER_RAD
 from seadesign.effects.base import Effect, Param, Scales, Search, lowpass, rows, time_steps
 
 
@@ -57,7 +58,7 @@ class LinearSpring(Effect):
 
     key = "spring"
     summary = "linear torsion spring: torque += k d"
-    parameters = (Param("k_Nm_per_rad", "Nm/rad", 9.106, 1e-3, 1e6, "torsional stiffness k"),)
+    parameters = (Param("k_Nm_per_rad", "Nm/rad", THESIS_K_MEASURED_NM_PER_RAD, 1e-3, 1e6, "torsional stiffness k"),)
     reads = ("deflection",)
     writes = "torque"
 

@@ -11,6 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from seadesign.constants import (THESIS_BEARING_RADIUS_M, THESIS_FEA_RESULTS, THESIS_K_MEASURED_NM_PER_RAD,
+                                 XH540_STALL_TORQUE_NM)
 from seadesign.data import write_bench
 from seadesign.loop.engine import Explanation, explain
 from seadesign.loop.report import write_report
@@ -18,8 +20,8 @@ from seadesign.loop.sea import bench_loop_data, calibration
 from seadesign.design.materials import load_material
 from seadesign.twin import BenchProtocol, bench_effects, simulate_bench
 
-K_MEASURED_NM_PER_RAD = 9.106
-K_FEA_NM_PER_RAD = 11.7 / (0.3532e-3 / 14e-3)  # thesis FEA: 0.3532 mm at 14 mm under 11.7 Nm
+# thesis FEA of the 9 x 8 mm part: its bearing displacement at r = 14 mm under the stall torque
+K_FEA_NM_PER_RAD = XH540_STALL_TORQUE_NM / (THESIS_FEA_RESULTS[(9, 8.0)][1] * 1e-3 / THESIS_BEARING_RADIUS_M)
 DEAD_BAND_RAD = 0.03
 
 
@@ -35,8 +37,8 @@ def worked_example(spring: dict[str, Any], out_dir: Path, seed: int = 0) -> tupl
     Returns the explanation and the calibration dict (also written as `thesis_calibration.json`).
     """
     out_dir = Path(out_dir)
-    chain = bench_effects(K_MEASURED_NM_PER_RAD).configure("dead_band", enabled=True, width_rad=DEAD_BAND_RAD)
-    table, meta = simulate_bench({**spring, "k_Nm_per_rad": K_MEASURED_NM_PER_RAD}, BenchProtocol(), effects=chain,
+    chain = bench_effects(THESIS_K_MEASURED_NM_PER_RAD).configure("dead_band", enabled=True, width_rad=DEAD_BAND_RAD)
+    table, meta = simulate_bench({**spring, "k_Nm_per_rad": THESIS_K_MEASURED_NM_PER_RAD}, BenchProtocol(), effects=chain,
                                  seed=seed)
     write_bench(table, out_dir / "thesis_bench.csv", meta)
     fea = thesis_spring(spring)
