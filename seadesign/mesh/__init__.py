@@ -79,6 +79,8 @@ def mesh_part(
     the bounding-box diagonal: edge_length_fac = h / diag, epsilon as given). Each attempt runs
     in a child process limited to timeout_s; a failed, timed-out or oversized (> max_tets) attempt is retried `retries` times, then MeshError.
     Meshes are cached by content under cache_dir (default: cache.default_cache_dir()).
+    Its length is the options and this text; the body is five steps (inputs, size check, cache,
+    mesh, name the boundaries), each a call.
     """
     _check_options(backend, elements_across_beam, beam_width_mm, layers, elements_per_circle)
     size_mm = beam_width_mm / elements_across_beam
