@@ -211,7 +211,7 @@ def test_torque_curve_refuses_to_extrapolate_unless_a_hard_stop():
     stop = TorqueCurve(CURVE_RAD, CURVE_NM, stop_reason="contact", hard_stop=True)
     np.testing.assert_allclose(stop.rotation(np.array([7.0, -9.0])), [0.475, -0.475])
     np.testing.assert_allclose(stop.torque(np.array([0.6])), [6.517])
-    with pytest.raises(ConfigError, match="torque_curve/torque_Nm must strictly increase"):
+    with pytest.raises(ConfigError, match="torque_curve/torque_Nm must increase strictly"):
         TorqueCurve((0.0, 0.1, 0.2), (0.0, 1.0, 1.0))
     with pytest.raises(ConfigError, match="must start at"):
         TorqueCurve((0.01, 0.1, 0.2), (0.0, 1.0, 2.0))

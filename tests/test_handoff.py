@@ -65,7 +65,7 @@ def test_schema_2_carries_a_torque_curve(spring_dict):
 @pytest.mark.parametrize("changes, problem", [
     ({"torque_Nm": [0.0, 1.8, 1.7, 4.9]}, "increase strictly"),
     ({"rotation_rad": [0.0, 0.1, 0.2]}, "3 points"),
-    ({"rotation_rad": [0.05, 0.1, 0.2, 0.3]}, "not at \\(0, 0\\)"),
+    ({"rotation_rad": [0.05, 0.1, 0.2, 0.3]}, "must start at \\(0, 0\\)"),
     ({"stop_reason": "gave up"}, "torque_curve/stop_reason"),
     ({"torque_Nm": [0.0, -1.0, 3.5, 4.9]}, "torque_curve/torque_Nm/1"),
 ])

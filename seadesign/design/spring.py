@@ -1,4 +1,5 @@
-"""spring.json: the handoff between the design sweep and the simulator, training and loop.
+"""spring.json: the handoff between the design sweep and the simulator, training and loop, and
+the one `TorqueCurve` type that reads, checks and interpolates its large-deflection curve.
 
 The file is the only thing the downstream half reads. It is validated against
 `schemas/spring.schema.json` on read and on write, so a bad file is refused with the
@@ -12,11 +13,15 @@ import json
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 import jsonschema
+import numpy as np
+from scipy.interpolate import PchipInterpolator
 
-from seadesign.errors import SpringFileError
+from seadesign.errors import ConfigError, DataError, SpringFileError
+
+STOP_REASONS = ("target_reached", "limit_point", "bifurcation", "contact", "strain_limit", "unconverged")
 
 SCHEMA_VERSION = 2  # what the sweep writes; readers take every version the schema lists
 
@@ -72,34 +77,112 @@ def write_spring(data: dict[str, Any], path: str | Path) -> Path:
     return path
 
 
+class CurveRangeError(DataError):
+    """A rotation or torque lies past the end of the spring's torque curve (nothing is extrapolated)."""
+
+
 @dataclass(frozen=True)
 class TorqueCurve:
-    """A spring's torque-rotation law for positive rotation (T(-theta) = -T(theta)): rotation in
-    rad and torque in Nm, both strictly increasing from (0, 0); where and why it ends."""
+    """Monotone torque-rotation points from (0, 0) (rad, Nm) and where and why they end."""
 
     rotation_rad: tuple[float, ...]
     torque_Nm: tuple[float, ...]
-    source: str
-    stop_reason: str
-    hard_stop: bool  # True: an end stop at the last point; False: past it is outside the model
+    source: str = "fea_large_deflection"
+    stop_reason: str = "target_reached"
+    hard_stop: bool = False
+
+    def __post_init__(self) -> None:
+        th, tq = np.asarray(self.rotation_rad, float), np.asarray(self.torque_Nm, float)
+        field = "torque_curve"
+        if th.ndim != 1 or th.shape != tq.shape or th.size < 2:
+            raise ConfigError(f"{field}: rotation_rad and torque_Nm must be lists of equal length, at least 2 "
+                              f"points; rotation_rad has {th.size} points, torque_Nm {tq.size}")
+        if not (np.isfinite(th).all() and np.isfinite(tq).all()):
+            raise ConfigError(f"{field}: rotation_rad and torque_Nm must be finite numbers")
+        if th[0] != 0.0 or tq[0] != 0.0:
+            raise ConfigError(f"{field}: the curve must start at (0, 0); it starts at ({th[0]}, {tq[0]}) rad, Nm")
+        for name, v in (("rotation_rad", th), ("torque_Nm", tq)):
+            bad = np.flatnonzero(np.diff(v) <= 0)
+            if bad.size:
+                raise ConfigError(f"{field}/{name} must increase strictly (positive rotation only; a curve past a "
+                                  f"torque maximum has no inverse: it ends at the limit point); it does not at index "
+                                  f"{int(bad[0]) + 1}")
+        if self.stop_reason not in STOP_REASONS:
+            raise ConfigError(f"{field}/stop_reason '{self.stop_reason}' is unknown; use one of {', '.join(STOP_REASONS)}")
+
+    @classmethod
+    def from_handoff(cls, curve: Mapping[str, Any]) -> "TorqueCurve":
+        """From spring.json's `torque_curve` object (the end point is the last listed point)."""
+        missing = [k for k in ("rotation_rad", "torque_Nm") if k not in curve]
+        if missing:
+            raise ConfigError(f"torque_curve lacks {', '.join(missing)}")
+        return cls(tuple(map(float, curve["rotation_rad"])), tuple(map(float, curve["torque_Nm"])),
+                   str(curve.get("source", "fea_large_deflection")), str(curve.get("stop_reason", "target_reached")),
+                   bool(curve.get("hard_stop", False)))
+
+    @property
+    def end_rotation_rad(self) -> float:
+        return self.rotation_rad[-1]
+
+    @property
+    def end_torque_Nm(self) -> float:
+        return self.torque_Nm[-1]
+
+    def _end(self) -> str:
+        return (f"the curve ends at {self.end_rotation_rad:.4g} rad, {self.end_torque_Nm:.4g} Nm "
+                f"(source {self.source}, stop reason {self.stop_reason}) and is not extrapolated")
+
+    def _pchip(self) -> PchipInterpolator:
+        if "_p" not in self.__dict__:
+            object.__setattr__(self, "_p", PchipInterpolator(self.rotation_rad, self.torque_Nm, extrapolate=False))
+        return self.__dict__["_p"]
+
+    def slope_at_zero(self) -> float:
+        """Initial stiffness dT/dtheta at 0 (Nm/rad)."""
+        return float(self._pchip().derivative()(0.0))
+
+    def torque(self, rotation_rad: np.ndarray) -> np.ndarray:
+        """T(theta) (Nm), odd in theta; past the end: the end torque with a hard stop, else CurveRangeError."""
+        th = np.asarray(rotation_rad, dtype=float)
+        a = np.abs(th)
+        past = a > self.end_rotation_rad
+        if past.any() and not self.hard_stop:
+            raise CurveRangeError(f"rotation {float(a.max()):.4g} rad is past the spring's torque curve: {self._end()}")
+        return np.sign(th) * self._pchip()(np.minimum(a, self.end_rotation_rad))
+
+    def rotation(self, torque_Nm: np.ndarray, iterations: int = 60, clamp: bool = False) -> np.ndarray:
+        """theta(T) (rad), the exact inverse of `torque`; past the end torque: the end rotation with a hard
+        stop or `clamp` (a fitter's trial values), else CurveRangeError."""
+        tq = np.asarray(torque_Nm, dtype=float)
+        a = np.abs(tq)
+        past = a > self.end_torque_Nm
+        if past.any() and not (self.hard_stop or clamp):
+            raise CurveRangeError(f"torque {float(a.max()):.4g} Nm is past the spring's torque curve: {self._end()}")
+        a = np.minimum(a, self.end_torque_Nm)
+        nodes, p = np.asarray(self.torque_Nm), self._pchip()
+        i = np.clip(np.searchsorted(nodes, a, side="right") - 1, 0, nodes.size - 2)
+        c = p.c[:, i]
+        lo, hi = np.zeros_like(a), np.diff(self.rotation_rad)[i]
+        u = hi * (a - nodes[i]) / (nodes[i + 1] - nodes[i])  # start from the chord
+        for _ in range(iterations):  # Newton kept inside a shrinking bracket (bisection when it would leave)
+            f = ((c[0] * u + c[1]) * u + c[2]) * u + c[3] - a
+            if np.all(np.abs(f) <= 1e-14 * self.end_torque_Nm):
+                break
+            lo, hi = np.where(f < 0, u, lo), np.where(f > 0, u, hi)
+            df = (3 * c[0] * u + 2 * c[1]) * u + c[2]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                newton = u - f / df
+            u = np.where((df > 0) & (newton > lo) & (newton < hi), newton, 0.5 * (lo + hi))
+        return np.sign(tq) * (np.asarray(self.rotation_rad)[i] + u)
 
 
 def torque_curve(spring: dict[str, Any], source: str = "spring.json") -> TorqueCurve | None:
     """The spring's torque curve (schema 2), or None when it has only k; refuses a curve that is
-    not strictly increasing from (0, 0)."""
+    not strictly increasing from (0, 0), naming the field."""
     block = spring.get("torque_curve")
     if block is None:
         return None
-    theta, torque = block["rotation_rad"], block["torque_Nm"]
-    problems = []
-    if len(theta) != len(torque):
-        problems.append(f"rotation_rad has {len(theta)} points, torque_Nm {len(torque)}")
-    elif theta[0] != 0 or torque[0] != 0:
-        problems.append(f"it starts at ({theta[0]:g} rad, {torque[0]:g} Nm), not at (0, 0)")
-    elif any(b <= a for a, b in zip(theta, theta[1:])) or any(b <= a for a, b in zip(torque, torque[1:])):
-        problems.append("rotation and torque must both increase strictly (a curve past a torque maximum "
-                        "has no inverse; it ends at the limit point)")
-    if problems:
-        raise SpringFileError(f"{source}: field 'torque_curve': {'; '.join(problems)}")
-    return TorqueCurve(tuple(map(float, theta)), tuple(map(float, torque)), block["source"], block["stop_reason"],
-                       bool(block["hard_stop"]))
+    try:
+        return TorqueCurve.from_handoff(block)
+    except ConfigError as exc:
+        raise SpringFileError(f"{source}: field {exc}") from None
