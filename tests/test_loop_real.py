@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from conftest import shared_path
-from seadesign.data import clean, is_hanging, read_recording
+from seadesign.data import KNEE_NAMES, clean, is_hanging, read_recording
 from seadesign.loop import explain
 from seadesign.loop.sea import robot_declared, robot_loop_data
 
@@ -36,7 +36,7 @@ ROWS = {
 
 def readme_row(name: str, knee: str) -> str:
     found, unsupported, before, after = ROWS[(name, knee)]
-    return (f"| {name}, {'left' if knee == 'l' else 'right'} | {', '.join(found)} | {', '.join(unsupported) or '-'} "
+    return (f"| {name}, {KNEE_NAMES[knee]} | {', '.join(found)} | {', '.join(unsupported) or '-'} "
             f"| {before:.4g} -> {after:.4g} |")
 
 

@@ -144,3 +144,15 @@ def test_partial_recording_is_the_full_runs_prefix(spring_dict):
     same = [c for c in full.columns if not c.endswith(("_cmd_vel", "_cmd_acc"))]
     pd.testing.assert_frame_equal(got[same], prefix[same])
     assert np.allclose(got["l_cmd_vel"].to_numpy()[: m - 2], prefix["l_cmd_vel"].to_numpy()[: m - 2])
+
+
+def test_the_simulators_speak_the_one_signal_vocabulary():
+    from seadesign.effects import SIGNALS
+    from seadesign.twin import KneeConfig, bench_effects, knee_effects
+
+    cfg = KneeConfig(k_Nm_per_rad=9.0, stall_torque_Nm=11.7, no_load_speed_rad_per_s=4.8, backlash_rad=0.004,
+                     mass_kg=8.0, lower_leg_m=0.2, upper_leg_m=0.2)
+    for chain in (knee_effects(cfg), bench_effects(9.0)):
+        for e in chain:
+            used = [e.signal(r) for r in e.reads] + [e.target()]
+            assert set(used) <= set(SIGNALS), (e.name, set(used) - set(SIGNALS))

@@ -27,7 +27,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from seadesign.corrector.modalities import MIRRORED_CHANNELS, MODALITIES, channels, resolve_modalities
-from seadesign.data import KNEE_NAMES
+from seadesign.data import KNEE_NAMES, KNEE_SIGN_BY_NAME
 from seadesign.errors import DataError, SeadesignError
 
 KNEES = tuple(KNEE_NAMES.values())  # ("left", "right")
@@ -163,7 +163,7 @@ def _knee_rows(rec: Recording, knee: str, spec: DatasetSpec) -> tuple[np.ndarray
         y = ch[COMMAND][t]
     else:
         y = motor[t + 1]
-    sign = -1.0 if (spec.positive and knee == "right") else 1.0
+    sign = KNEE_SIGN_BY_NAME[knee] if spec.positive else 1.0
     if sign < 0:
         names = spec.feature_names()
         flip = np.array([-1.0 if n.split("@")[0] in MIRRORED_CHANNELS else 1.0 for n in names])
@@ -204,7 +204,7 @@ class FeatureBuilder:
 
     def __init__(self, spec: DatasetSpec, knee: str) -> None:
         self.spec, self.knee = spec, knee
-        self.sign = -1.0 if (spec.positive and knee == "right") else 1.0
+        self.sign = KNEE_SIGN_BY_NAME[knee] if spec.positive else 1.0
         self._chans = channels(spec.modalities)
         self._past: deque[dict[str, float]] = deque(maxlen=spec.history + 1)
         names = spec.feature_names()

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from seadesign.data import KNEE_SIGN_BY_NAME
+
 from seadesign.corrector.dataset import KNEES, Recording
 from seadesign.corrector.modalities import IMU_CHANNELS, PRESSURE_CHANNELS
 
@@ -27,7 +29,7 @@ def linear_spring_recording(k_Nm_per_rad: float, duration_s: float = 30.0, rate_
         tau = 1.0 + 2.0 * np.sin(w * t + phase + 0.7) + 0.4 * np.sin(3 * w * t)
         hall = motor - tau / k_Nm_per_rad
         effort = tau + effort_noise_Nm * rng.standard_normal(len(t))
-        sign = 1.0 if knee == "left" else -1.0
+        sign = KNEE_SIGN_BY_NAME[knee]
         ch = {
             "motor_pos_rad": sign * motor, "hall_pos_rad": sign * hall, "effort_Nm": sign * effort,
             "motor_vel_rad_per_s": sign * np.gradient(motor, t), "hall_vel_rad_per_s": sign * np.gradient(hall, t),

@@ -25,6 +25,7 @@ from seadesign.data.plots import plot_recording
 from seadesign.data.robot import (
     FIELD_SIGNALS,
     KNEE_NAMES,
+    KNEE_SIGN_BY_NAME,
     KNEE_SIGN,
     KNEES,
     RECORDING_COLUMNS,
@@ -36,7 +37,7 @@ from seadesign.data.robot import (
 
 __all__ = [
     "ArtefactReport", "CleanResult", "plot_recording", "Thresholds", "clean", "detect_artefacts", "is_hanging", "quaternion_to_euler", "write_cleaned",
-    "BENCH_OPTIONAL", "BENCH_REQUIRED", "FIELD_SIGNALS", "KNEES", "KNEE_NAMES", "KNEE_SIGN", "KneeChannels",
+    "BENCH_OPTIONAL", "BENCH_REQUIRED", "FIELD_SIGNALS", "KNEES", "KNEE_NAMES", "KNEE_SIGN", "KNEE_SIGN_BY_NAME", "KneeChannels",
     "RECORDING_COLUMNS", "knee_channels",
     "read_bench", "read_metadata", "read_recording", "sidecar_path", "write_bench",
     "write_metadata", "write_recording",

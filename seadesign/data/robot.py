@@ -65,6 +65,8 @@ RECORDING_COLUMNS = (
 KNEE_SIGN = {"l": 1.0, "r": -1.0}
 #: Knee side in the file -> knee name (the corrector's and the simulator's knee axis: 0 left, 1 right).
 KNEE_NAMES = {"l": "left", "r": "right"}
+#: Knee name -> its sign in the file (the mirroring that a flexion-convention model undoes).
+KNEE_SIGN_BY_NAME = {KNEE_NAMES[side]: KNEE_SIGN[side] for side in KNEES}
 #: Per-knee field of the file -> signal of the one vocabulary (`seadesign.effects.SIGNALS`).
 FIELD_SIGNALS = {"knee_pos": "motor", "hall_pos": "hall", "knee_vel": "motor_velocity", "hall_vel": "hall_velocity",
                  "knee_eff": "effort"}

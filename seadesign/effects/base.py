@@ -45,6 +45,8 @@ SIGNALS: dict[str, tuple[str, str]] = {
     "motor_velocity": ("rad/s", "motor output angular velocity"),
     "hall_velocity": ("rad/s", "finite difference of the Hall reading (as the robot logs it)"),
     "effort": ("Nm", "torque the servo reports (from its current)"),
+    "deflection_rate": ("rad/s", "rate of the deflection (bench: the spring's twist rate)"),
+    "torque_sensor": ("Nm", "a bench's torque-sensor reading of the spring torque"),
     "temperature": ("degC", "measured spring temperature (optional)"),
     "energy": ("J", "cumulative dissipated energy (optional)"),
 }

@@ -34,7 +34,7 @@ import pandas as pd
 
 from seadesign import __version__
 from seadesign.constants import G_M_PER_S2
-from seadesign.data.robot import COMMAND_COLUMNS, IMU_COLUMNS, KNEE_SIGN, PRESSURE_COLUMNS, RECORDING_COLUMNS
+from seadesign.data.robot import COMMAND_COLUMNS, IMU_COLUMNS, KNEE_FIELDS, KNEE_SIGN, PRESSURE_COLUMNS, RECORDING_COLUMNS
 from seadesign.effects import EffectChain, effect_rng
 from seadesign.errors import ConfigError
 from seadesign.design.spring import load_spring
@@ -42,7 +42,7 @@ from seadesign.twin.config import KneeConfig, knee_effects
 from seadesign.twin.walk import Gait, Trial, knee_targets
 
 SIGN = np.array([KNEE_SIGN["l"], KNEE_SIGN["r"]])  # knee axis: 0 left, 1 right
-FIELDS = ("knee_pos", "hall_pos", "knee_vel", "hall_vel", "knee_eff")
+FIELDS = KNEE_FIELDS  # the per-knee fields of the robot format, logged in its order
 
 
 @dataclass
