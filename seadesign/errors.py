@@ -23,3 +23,8 @@ class MeshError(SeadesignError):
 
 class SolverError(SeadesignError):
     """A finite-element solve failed or its inputs are invalid."""
+
+
+class NotPositiveDefinite(SolverError):
+    """A stiffness matrix has a zero or negative pivot: the structure is under-constrained, or (a
+    tangent stiffness on a load path) it has lost stability."""

@@ -6,13 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers_annulus import annulus_mesh
-from skfem import Basis, ElementTetP1, ElementTetP2, ElementVector, MeshTet, asm
+from helpers_skfem import skfem_permutation
+from skfem import asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from seadesign.errors import SolverError
 from seadesign.fea.assembly import mass_upper, nodal_forces, stiffness_upper
 from seadesign.fea.couplings import couple
-from seadesign.fea.elements import element_mesh, midside_nodes
+from seadesign.fea.elements import element_mesh
 from seadesign.fea.linsolve import SPDFactorization, full_from_upper
 
 E, NU = 12e6, 0.48
@@ -24,25 +25,12 @@ def small():
     return m.points_mm * 1e-3, m.tets
 
 
-def _skfem_permutation(points, tets, emesh):
-    """Our dof index of each scikit-fem dof (vector P1/P2, 3 components per node)."""
-    mesh = MeshTet(points.T.copy(), tets.T.copy())
-    basis = Basis(mesh, ElementVector(ElementTetP2() if emesh.order == 2 else ElementTetP1()))
-    ours = np.empty(basis.N, dtype=np.int64)
-    for c in range(3):
-        ours[basis.nodal_dofs[c]] = 3 * np.arange(mesh.nvertices) + c
-        if emesh.order == 2:
-            mid = midside_nodes(emesh, mesh.edges[0], mesh.edges[1])
-            ours[basis.edge_dofs[c]] = 3 * mid + c
-    return basis, ours
-
-
 @pytest.mark.parametrize("order", [1, 2])
 def test_stiffness_equals_scikit_fem(small, order):
     points, tets = small
     emesh = element_mesh(points, tets, order)
     ours = full_from_upper(stiffness_upper(emesh, E, NU).matrix()).toarray()
-    basis, perm = _skfem_permutation(points, tets, emesh)
+    basis, perm = skfem_permutation(points, tets, emesh)
     ref = asm(linear_elasticity(*lame_parameters(E, NU)), basis).toarray()
     mine = ours[np.ix_(perm, perm)]
     assert np.abs(mine - ref).max() < 1e-9 * np.abs(ref).max()

@@ -17,7 +17,7 @@ from functools import cache
 import numpy as np
 import scipy.sparse as sp
 
-from seadesign.errors import SolverError
+from seadesign.errors import NotPositiveDefinite, SolverError
 
 _SPD = 2  # PARDISO mtype: real symmetric positive definite
 _ERRORS = {
@@ -85,8 +85,18 @@ class Pardiso:
         )
         if err.value != 0:
             self.close()
+            if err.value == -4:
+                raise NotPositiveDefinite(f"PARDISO failed in phase {phase}: {_ERRORS[-4]}")
             raise SolverError(f"PARDISO failed in phase {phase}: {_ERRORS.get(err.value, f'error {err.value}')}")
         return x
+
+    def refactor(self, upper: sp.csr_matrix | sp.bsr_matrix) -> None:
+        """Factor new values on the same sparsity pattern, reusing the ordering and symbolic analysis."""
+        upper.sort_indices()
+        if not (np.array_equal(upper.indptr, self._ia) and np.array_equal(upper.indices, self._ja)):
+            raise SolverError("refactor needs the sparsity pattern of the first factorization")
+        self._data = np.ascontiguousarray(upper.data, dtype=np.float64)
+        self._call(22, np.zeros(self.n))
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solution for one (n,) or several (n, r) right-hand sides."""

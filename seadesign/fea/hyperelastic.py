@@ -1,0 +1,140 @@
+"""Finite-strain hyperelastic laws in CalculiX's form, as functions of the deformation gradient.
+
+W = sum Cij (I1bar - 3)^i (I2bar - 3)^j + sum_k (J - 1)^(2k) / Dk, with I1bar = J^(-2/3) tr C and
+I2bar = J^(-4/3) I2(C) the isochoric invariants (C = F^T F, J = det F). `stress` gives the first
+Piola-Kirchhoff stress P = dW/dF (Pa) and `tangent` A = dP/dF (Pa), both vectorised over any
+leading axes of F (..., 3, 3). Moduli in Pa, compressibilities in 1/Pa (0: the term is absent).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from seadesign.design.materials import Hyperelastic
+
+_I = np.eye(3)
+
+
+@dataclass(frozen=True)
+class _Kinematics:
+    """Invariants of F (..., 3, 3) and their first derivatives with respect to F."""
+
+    F: np.ndarray
+    J: np.ndarray
+    H: np.ndarray  # F^-T
+    I1: np.ndarray
+    I2: np.ndarray
+    C: np.ndarray
+    dI2: np.ndarray  # dI2/dF = 2 (I1 F - F C)
+
+    @classmethod
+    def of(cls, F: np.ndarray) -> "_Kinematics":
+        J = np.linalg.det(F)
+        if np.any(J <= 0):
+            raise FloatingPointError("inverted element: det F <= 0")
+        C = np.swapaxes(F, -1, -2) @ F
+        I1 = np.trace(C, axis1=-2, axis2=-1)
+        I2 = 0.5 * (I1**2 - np.einsum("...ij,...ji->...", C, C))
+        H = np.swapaxes(np.linalg.inv(F), -1, -2)
+        dI2 = 2.0 * (I1[..., None, None] * F - F @ C)
+        return cls(F, J, H, I1, I2, C, dI2)
+
+
+def volumetric(law: Hyperelastic, J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The volumetric energy U(J) = sum (J - 1)^(2k) / Dk (J/m^3) and its derivatives U', U'' (Pa)."""
+    j = np.asarray(J, dtype=float) - 1.0
+    u, du, ddu = np.zeros_like(j), np.zeros_like(j), np.zeros_like(j)
+    for k, d in enumerate((law.d1_per_Pa, law.d2_per_Pa, law.d3_per_Pa), start=1):
+        if d > 0:
+            u = u + j ** (2 * k) / d
+            du = du + 2 * k * j ** (2 * k - 1) / d
+            ddu = ddu + 2 * k * (2 * k - 1) * j ** (2 * k - 2) / d
+    return u, du, ddu
+
+
+def _isochoric(law: Hyperelastic, i1b: np.ndarray, i2b: np.ndarray) -> tuple[np.ndarray, ...]:
+    """dW/dI1bar, dW/dI2bar, d2W/dI1bar2, d2W/dI2bar2 (no mixed terms in these laws)."""
+    a, b = i1b - 3.0, i2b - 3.0
+    w1 = law.c10_Pa + 2 * law.c20_Pa * a + 3 * law.c30_Pa * a**2
+    w11 = 2 * law.c20_Pa + 6 * law.c30_Pa * a
+    return w1, np.full_like(b, law.c01_Pa), w11, np.zeros_like(b)
+
+
+def isochoric_energy_density(law: Hyperelastic, F: np.ndarray) -> np.ndarray:
+    """The isochoric part of W (J/m^3) at each F (..., 3, 3)."""
+    kin = _Kinematics.of(F)
+    a = kin.J ** (-2 / 3) * kin.I1 - 3.0
+    b = kin.J ** (-4 / 3) * kin.I2 - 3.0
+    return law.c10_Pa * a + law.c20_Pa * a**2 + law.c30_Pa * a**3 + law.c01_Pa * b
+
+
+def energy_density(law: Hyperelastic, F: np.ndarray) -> np.ndarray:
+    """Strain energy per reference volume (J/m^3) at each F (..., 3, 3)."""
+    return isochoric_energy_density(law, F) + volumetric(law, np.linalg.det(F))[0]
+
+
+def _first(kin: _Kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """I1bar, I2bar and their derivatives dI1bar/dF, dI2bar/dF."""
+    j23, j43 = kin.J ** (-2 / 3), kin.J ** (-4 / 3)
+    e = (..., None, None)
+    d1 = j23[e] * (2.0 * kin.F - (2 / 3) * kin.I1[e] * kin.H)
+    d2 = j43[e] * (kin.dI2 - (4 / 3) * kin.I2[e] * kin.H)
+    return j23 * kin.I1, j43 * kin.I2, d1, d2
+
+
+def stress(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> np.ndarray:
+    """First Piola-Kirchhoff stress P = dW/dF (Pa), shape of F. `pressure_Pa` replaces U'(J) (a mean
+    dilatation formulation passes U' of the element's mean J)."""
+    kin = _Kinematics.of(F)
+    i1b, i2b, d1, d2 = _first(kin)
+    w1, w2, *_ = _isochoric(law, i1b, i2b)
+    wj = volumetric(law, kin.J)[1] if pressure_Pa is None else pressure_Pa
+    e = (..., None, None)
+    return w1[e] * d1 + w2[e] * d2 + (wj * kin.J)[e] * kin.H
+
+
+def _outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., :, :, None, None] * b[..., None, None, :, :]
+
+
+def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """P (..., 3, 3) and A = dP/dF (..., 3, 3, 3, 3) with A[..., i, J, k, L] = dP_iJ / dF_kL (Pa).
+    With `pressure_Pa` (U' given, as in `stress`), U'' is left out: the caller adds the volumetric stiffness."""
+    kin = _Kinematics.of(F)
+    i1b, i2b, d1, d2 = _first(kin)
+    w1, w2, w11, w22 = _isochoric(law, i1b, i2b)
+    if pressure_Pa is None:
+        _, wj, wjj = volumetric(law, kin.J)
+    else:
+        wj, wjj = pressure_Pa, np.zeros_like(kin.J)
+    F, H, J, I1, I2 = kin.F, kin.H, kin.J, kin.I1, kin.I2
+    e, e4 = (..., None, None), (..., None, None, None, None)
+    hh = _outer(H, H)  # H_iJ H_kL
+    hx = np.swapaxes(hh, -3, -1)  # H_iL H_kJ
+    ii = np.broadcast_to(np.einsum("ik,JL->iJkL", _I, _I), F.shape[:-2] + (3, 3, 3, 3))
+
+    # d2 I1bar / dF2
+    j23 = J ** (-2 / 3)
+    dd1 = j23[e4] * (
+        -(2 / 3) * _outer(2.0 * F - (2 / 3) * I1[e] * H, H)
+        + 2.0 * ii - (4 / 3) * _outer(H, F) + (2 / 3) * I1[e4] * hx
+    )
+    P = w1[e] * d1 + w2[e] * d2 + (wj * J)[e] * H
+    a = w11[e4] * _outer(d1, d1) + w1[e4] * dd1
+    if np.any(w2) or np.any(w22):
+        # d2 I2 / dF2 = 2 (2 F_kL F_iJ + I1 d_ik d_JL - d_ik C_LJ - F_iL F_kJ - b_ik d_JL), b = F F^T
+        b = F @ np.swapaxes(F, -1, -2)
+        ff = _outer(F, F)
+        ddi2 = 2.0 * (2.0 * ff + I1[e4] * ii - np.einsum("ik,...LJ->...iJkL", _I, kin.C)
+                      - np.swapaxes(ff, -3, -1) - np.einsum("...ik,JL->...iJkL", b, _I))
+        j43 = J ** (-4 / 3)
+        dd2 = j43[e4] * (
+            -(4 / 3) * _outer(kin.dI2 - (4 / 3) * I2[e] * H, H)
+            + ddi2 - (4 / 3) * _outer(H, kin.dI2) + (4 / 3) * I2[e4] * hx
+        )
+        a = a + w22[e4] * _outer(d2, d2) + w2[e4] * dd2
+    # d/dF (dW/dJ J H) = (d2W/dJ2 J^2 + dW/dJ J) H x H - dW/dJ J H_iL H_kJ
+    a = a + (wjj * J**2 + wj * J)[e4] * hh - (wj * J)[e4] * hx
+    return P, a

@@ -1,0 +1,168 @@
+"""Finite-strain elasticity against independent references: finite differences of the energy,
+scikit-fem's assembly of the same law written here on its own (directional derivative in
+closed form), the linear model at zero strain, and the linear solver's torsional stiffness."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers_annulus import annulus_mesh
+from helpers_skfem import skfem_permutation
+from skfem import BilinearForm, LinearForm, asm
+from skfem.helpers import grad
+
+from seadesign.design.materials import Hyperelastic
+from seadesign.fea.assembly import stiffness_upper
+from seadesign.fea.elements import element_mesh
+from seadesign.fea.finite_strain import Solid
+from seadesign.fea.hyperelastic import energy_density, stress, tangent
+from seadesign.fea.linsolve import full_from_upper
+
+E, NU = 12e6, 0.48
+NEO = Hyperelastic.from_linear(E, NU)
+LAWS = {
+    "neo_hooke": NEO,
+    "mooney_rivlin": Hyperelastic("mooney_rivlin", 1.2e6, 2e-8, "test", c01_Pa=0.6e6),
+    "yeoh": Hyperelastic("yeoh", 1.5e6, 2e-8, "test", c20_Pa=-0.1e6, c30_Pa=0.02e6, d2_per_Pa=1e-7, d3_per_Pa=3e-7),
+}
+
+
+def _random_F(n: int, size: float, seed: int = 0) -> np.ndarray:
+    return np.eye(3) + size * np.random.default_rng(seed).standard_normal((n, 3, 3))
+
+
+@pytest.mark.parametrize("name", LAWS)
+def test_stress_and_tangent_are_the_derivatives_of_the_energy(name):
+    law, F, h = LAWS[name], _random_F(6, 0.3), 1e-6
+    P, A = tangent(law, F)
+    assert np.array_equal(P, stress(law, F))
+    p_fd, a_fd = np.zeros_like(P), np.zeros_like(A)
+    for k in range(3):
+        for l in range(3):
+            d = np.zeros((3, 3))
+            d[k, l] = h
+            p_fd[..., k, l] = (energy_density(law, F + d) - energy_density(law, F - d)) / (2 * h)
+            a_fd[..., k, l] = (stress(law, F + d) - stress(law, F - d)) / (2 * h)
+    # central differences: measured 6e-11 to 1.6e-10 of the largest entry
+    assert np.abs(P - p_fd).max() < 5e-10 * np.abs(P).max()
+    assert np.abs(A - a_fd).max() < 5e-10 * np.abs(A).max()
+
+
+def test_neo_hooke_from_E_and_nu_is_the_linear_model_at_zero_strain():
+    lam, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
+    _, A = tangent(NEO, np.eye(3)[None])
+    i = np.eye(3)
+    c = lam * np.einsum("ij,kl->ijkl", i, i) + mu * (np.einsum("ik,jl->ijkl", i, i) + np.einsum("il,jk->ijkl", i, i))
+    assert np.abs(A[0] - c).max() < 1e-12 * np.abs(c).max()
+
+
+# --- scikit-fem: the same compressible neo-Hookean law (CalculiX's NEO HOOKE), written independently ----
+
+
+def _last(a):  # (3, 3, e, q) -> (e, q, 3, 3)
+    return np.moveaxis(a, (0, 1), (-2, -1))
+
+
+def _first(a):
+    return np.moveaxis(a, (-2, -1), (0, 1))
+
+
+def _neo_hooke_parts(F, c10, d1):
+    Fl = _last(F)
+    J = np.linalg.det(Fl)
+    H = np.swapaxes(np.linalg.inv(Fl), -1, -2)
+    I1 = np.einsum("...ij,...ij->...", Fl, Fl)
+    return Fl, J, H, I1
+
+
+def _P(F, c10, d1):
+    Fl, J, H, I1 = _neo_hooke_parts(F, c10, d1)
+    j23 = J ** (-2 / 3)
+    P = c10 * j23[..., None, None] * (2 * Fl - (2 / 3) * I1[..., None, None] * H) \
+        + (2 / d1) * ((J - 1) * J)[..., None, None] * H
+    return _first(P)
+
+
+def _dP(F, G, c10, d1):
+    """Directional derivative of P at F along G (both (3, 3, e, q))."""
+    Fl, J, H, I1 = _neo_hooke_parts(F, c10, d1)
+    Gl = _last(G)
+    hg = np.einsum("...ij,...ij->...", H, Gl)  # tr(F^-1 G)
+    dI1 = 2 * np.einsum("...ij,...ij->...", Fl, Gl)
+    dH = -H @ np.swapaxes(Gl, -1, -2) @ H
+    j23 = J ** (-2 / 3)
+    e = (..., None, None)
+    iso = c10 * (-(2 / 3) * (j23 * hg)[e] * (2 * Fl - (2 / 3) * I1[e] * H)
+                 + j23[e] * (2 * Gl - (2 / 3) * dI1[e] * H - (2 / 3) * I1[e] * dH))
+    vol = (2 / d1) * (((2 * J - 1) * J * hg)[e] * H + ((J - 1) * J)[e] * dH)
+    return _first(iso + vol)
+
+
+@pytest.fixture(scope="module")
+def small():
+    m = annulus_mesh(5.0, 12.0, 3.0, n_r=2, n_theta=12, n_z=1)
+    return m.points_mm * 1e-3, m.tets
+
+
+def test_residual_and_tangent_equal_scikit_fem(small):
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    x = emesh.nodes_m / 0.012
+    u = 0.6e-3 * np.column_stack([np.sin(2 * x[:, 1]) * x[:, 2], x[:, 0] ** 2 - x[:, 2], np.cos(x[:, 0]) * x[:, 1]])
+    solid = Solid.of(emesh, NEO)
+    n = len(emesh.nodes_m)
+    forces = solid.forces(u).ravel()
+    k = full_from_upper(solid.tangent(u, np.arange(n), n).matrix()).toarray()
+
+    basis, perm = skfem_permutation(points, tets, emesh, intorder=2)  # the 4-point rule, as ours
+    c10, d1 = NEO.c10_Pa, NEO.d1_per_Pa
+    prev = basis.interpolate(u.ravel()[perm])
+
+    @LinearForm
+    def residual(v, w):
+        return np.einsum("ij...,ij...->...", _P(grad(w["prev"]) + np.eye(3)[:, :, None, None], c10, d1), grad(v))
+
+    @BilinearForm
+    def stiffness(du, v, w):
+        F = grad(w["prev"]) + np.eye(3)[:, :, None, None]
+        return np.einsum("ij...,ij...->...", _dP(F, grad(du), c10, d1), grad(v))
+
+    f_ref = asm(residual, basis, prev=prev)
+    k_ref = asm(stiffness, basis, prev=prev).toarray()
+    assert np.abs(solid.deformation_gradient(u) - np.eye(3)).max() > 0.05  # finite strain (0.09), not the linear limit
+    # measured: 2.5e-14 (forces) and 1.3e-15 (tangent) of the largest entry
+    assert np.abs(forces[perm] - f_ref).max() < 1e-13 * np.abs(f_ref).max()
+    assert np.abs(k[np.ix_(perm, perm)] - k_ref).max() < 1e-14 * np.abs(k_ref).max()
+
+
+@pytest.mark.parametrize("formulation", ["full", "mean_dilatation"])
+def test_forces_and_tangent_are_derivatives_of_the_energy(small, formulation):
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    rng = np.random.default_rng(1)
+    u = 5e-5 * rng.standard_normal(emesh.nodes_m.shape)  # |F - I| up to 0.25
+    solid = Solid.of(emesh, Hyperelastic.from_linear(E, 0.499), formulation)
+    v = rng.standard_normal(u.shape)
+    h = 1e-9
+    e_fd = (solid.energy(u + h * v) - solid.energy(u - h * v)) / (2 * h)
+    f_fd = (solid.forces(u + h * v) - solid.forces(u - h * v)) / (2 * h)
+    assert solid.forces(u).ravel() @ v.ravel() == pytest.approx(e_fd, rel=1e-9)  # measured 1.4e-10, 2.1e-10
+    kv = solid.tangent_product(u, v)
+    n = len(u)
+    k = full_from_upper(solid.tangent(u, np.arange(n), n).matrix())
+    assert np.abs(kv - f_fd).max() < 5e-10 * np.abs(f_fd).max()  # measured 3.9e-11, 1.1e-10
+    assert np.abs((k @ v.ravel()).reshape(-1, 3) - kv).max() < 1e-12 * np.abs(kv).max()
+
+
+def test_tangent_at_rest_is_the_linear_stiffness(small):
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    n = len(emesh.nodes_m)
+    for formulation in ("full", "mean_dilatation"):
+        k = full_from_upper(Solid.of(emesh, NEO, formulation).tangent(np.zeros((n, 3)), np.arange(n), n).matrix())
+        lin = full_from_upper(stiffness_upper(emesh, E, NU).matrix())
+        err = abs(k - lin).max() / abs(lin).max()
+        if formulation == "full":
+            assert err < 1e-12
+        else:  # a constant pressure per element: softer, as the mixed P2/P0 element is
+            assert 1e-3 < err
