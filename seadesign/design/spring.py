@@ -21,7 +21,8 @@ from scipy.interpolate import PchipInterpolator
 
 from seadesign.errors import ConfigError, DataError, SpringFileError
 
-STOP_REASONS = ("target_reached", "limit_point", "bifurcation", "contact", "strain_limit", "unconverged")
+STOP_REASONS = (
+    "target_reached", "limit_point", "bifurcation", "contact", "strain_limit", "rotation_limit", "unconverged")
 
 SCHEMA_VERSION = 2  # what the sweep writes; readers take every version the schema lists
 

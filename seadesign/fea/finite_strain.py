@@ -19,7 +19,7 @@ import numpy as np
 from seadesign.design.materials import Hyperelastic
 from seadesign.fea.assembly import UpperBlocks, sum_pair_blocks
 from seadesign.fea.elements import ElementMesh, barycentric_gradients, quadrature, shape_dlam, upper_pairs
-from seadesign.fea.hyperelastic import isochoric_energy_density, stress, tangent, volumetric
+from seadesign.fea.hyperelastic import det_and_inverse_transpose, i1_tangent, isochoric_energy_density, stress, tangent, volumetric
 
 _CHUNK = 4096  # elements per vectorised block
 FORMULATIONS = ("full", "mean_dilatation")
@@ -27,11 +27,18 @@ FORMULATIONS = ("full", "mean_dilatation")
 
 @dataclass(frozen=True)
 class Solid:
-    """A hyperelastic body on an element mesh: shape-function gradients dN/dX (m, q, nen, 3) in 1/m at
-    the quadrature points, quadrature weights times volume (m, q) in m^3, the law and the formulation."""
+    """A hyperelastic body on an element mesh, the law and the volumetric formulation.
+
+    Shape-function gradients are combinations of the element's constant barycentric gradients
+    (straight-sided elements): G_a(x_q) = sum_k D[q, a, k] Gamma_k with D (q, nen, 4) the same for
+    every element. `bary` holds Gamma (m, 4, 3) in 1/m, `grads` G (m, q, nen, 3) in 1/m, and
+    `weights_m3` the quadrature weights times volume (m, q) in m^3.
+    """
 
     mesh: ElementMesh
     law: Hyperelastic
+    dlam: np.ndarray
+    bary: np.ndarray
     grads: np.ndarray
     weights_m3: np.ndarray
     formulation: str = "full"
@@ -43,15 +50,20 @@ class Solid:
         qlam, qw = quadrature(2 if mesh.order == 2 else 1)
         dlam = shape_dlam(mesh.order, qlam)  # (q, nen, 4)
         g, vol = barycentric_gradients(mesh.nodes_m, mesh.elements)
-        return cls(mesh, law, np.einsum("qak,mki->mqai", dlam, g), vol[:, None] * qw[None, :], formulation)
+        return cls(mesh, law, dlam, g, np.einsum("qak,mki->mqai", dlam, g), vol[:, None] * qw[None, :], formulation)
 
     def deformation_gradient(self, u_m: np.ndarray, elements: slice | np.ndarray = slice(None)) -> np.ndarray:
-        """F = I + grad u (m, q, 3, 3) at the quadrature points of the selected elements."""
-        return np.eye(3) + np.einsum("mai,mqaj->mqij", u_m[self.mesh.elements[elements]], self.grads[elements])
+        """F = I + grad u (m, q, 3, 3) at the quadrature points of the selected elements: the element's
+        displacements combined with the constant D (one product), then with its Gamma."""
+        ue = u_m[self.mesh.elements[elements]]  # (m, nen, 3)
+        q, nen = self.dlam.shape[0], self.dlam.shape[1]
+        d = self.dlam.transpose(0, 2, 1).reshape(q * 4, nen)
+        uk = (d @ ue.transpose(1, 0, 2).reshape(nen, -1)).reshape(q, 4, len(ue), 3)  # sum_a D[q, a, k] u_ai
+        return np.eye(3) + uk.transpose(2, 0, 3, 1) @ self.bary[elements][:, None]
 
     def _pressure(self, F: np.ndarray, w: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray]:
         """Mean dilatation: U'(Jbar) per point (m, q), U''(Jbar) per element and Jbar; full: None, None, J."""
-        J = np.linalg.det(F)
+        J = det_and_inverse_transpose(F)[0]
         if self.formulation == "full":
             return None, None, J
         jbar = (J * w).sum(axis=1) / w.sum(axis=1)
@@ -74,23 +86,74 @@ class Solid:
         for s in _chunks(len(self.mesh.elements)):
             F = self.deformation_gradient(u_m, s)
             p = stress(self.law, F, self._pressure(F, self.weights_m3[s])[0])
-            _scatter(f, self.mesh.elements[s], np.einsum("mqij,mqaj,mq->mai", p, self.grads[s], self.weights_m3[s]))
+            _scatter(f, self.mesh.elements[s], self._contract(p, s))
         return f
 
-    def _element_tangents(self, u_m: np.ndarray, el: slice | np.ndarray) -> np.ndarray:
-        """Element tangent stiffness (m, a, i, k, b) in N/m: K_ab[i, k] = sum_q w G_aJ A_iJkL G_bL, plus the
-        mean dilatation's rank-one volumetric term U''(Jbar) / V beta_a,i beta_b,k (beta = dv/du)."""
-        F, g, w = self.deformation_gradient(u_m, el), self.grads[el], self.weights_m3[el]
+    def _contract(self, p: np.ndarray, el: slice | np.ndarray) -> np.ndarray:
+        """f_ai = sum_q w P_ij G_aj (m, nen, 3) for P (m, q, 3, 3): (w P Gamma^T), then the constant D."""
+        r = (p * self.weights_m3[el][..., None, None]) @ np.swapaxes(self.bary[el], -1, -2)[:, None]  # (m, q, i, k)
+        q, nen = self.dlam.shape[0], self.dlam.shape[1]
+        m = len(r)
+        d = self.dlam.transpose(1, 0, 2).reshape(nen, q * 4)
+        return (d @ r.transpose(1, 3, 0, 2).reshape(q * 4, m * 3)).reshape(nen, m, 3).transpose(1, 0, 2)
+
+    def _point_terms(self, u_m: np.ndarray, el: slice | np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple | None]:
+        """The element tangent's point terms: K_ab[i, j] = sum_{q,k,l} D[q, a, k] D[q, b, l] E[q, k, l, m, i, j]
+        + D[q, a, l] D[q, b, k] X[q, k, l, m, i, j], with E + X = w sum_JL Gamma_kJ A_iJjL Gamma_lL and X the
+        part whose indices run crosswise (so that no term needs a transpose): one product with a constant
+        matrix (`_pair_coefficients`). Laws in I1bar and J build them from their tangent terms
+        (`hyperelastic.I1Tangent`) as outer products of F Gamma, H Gamma and D Gamma, never the 81-component
+        A. Also, for the mean dilatation, beta = dv/du (m, nen, 3) and U''(Jbar) / V (m,), else None."""
+        F, w, gam = self.deformation_gradient(u_m, el), self.weights_m3[el], self.bary[el]
         pressure, ddu, _ = self._pressure(F, w)
-        _, a = tangent(self.law, F, pressure)
-        m, q, nen = g.shape[0], g.shape[1], g.shape[2]
-        ga = np.einsum("mqaJ,mqiJkL,mq->mqaikL", g, a, w, optimize=True).reshape(m, q, nen * 9, 3)
-        k = (ga @ np.swapaxes(g, -1, -2)).sum(axis=1).reshape(m, nen, 3, 3, nen)
+        m, q = w.shape
+        if self.law.c01_Pa:
+            _, a = tangent(self.law, F, pressure)
+            e = np.einsum("mkJ,mqiJjL,mlL,mq->qklmij", gam, a, gam, w, optimize=True)
+            x = np.zeros_like(e)
+        else:
+            t = i1_tangent(self.law, F, pressure)
+            fg = gam[:, None] @ np.swapaxes(t.F, -1, -2)  # (F Gamma_k)_i
+            hg = gam[:, None] @ np.swapaxes(t.H, -1, -2)
+            # cross (F x H + H x F) + hh H x H = pg x hg + hg x pg
+            pg = (t.cross * w)[..., None, None] * fg + 0.5 * (t.hh * w)[..., None, None] * hg
+            left, right = [pg, hg], [hg, pg]
+            if np.any(t.w11):
+                dg = gam[:, None] @ np.swapaxes(t.D, -1, -2)
+                left, right = left + [(t.w11 * w)[..., None, None] * dg], right + [dg]
+            n = len(left)
+            e = (np.stack(left, axis=-1).reshape(m * q, 12, n) @ np.stack(right, axis=2).reshape(m * q, n, 12))
+            e = e.reshape(m, q, 4, 3, 4, 3)
+            gram = (gam @ np.swapaxes(gam, -1, -2))[:, None] * (t.delta * w)[..., None, None]
+            for i in range(3):
+                e[:, :, :, i, :, i] += gram
+            # hx H_iL H_jJ = (H Gamma_l)_i (H Gamma_k)_j: an outer product read with k and l exchanged
+            x = (((t.hx * w)[..., None, None] * hg).reshape(m * q, 12, 1) @ hg.reshape(m * q, 1, 12))
+            e = e.transpose(1, 2, 4, 0, 3, 5)
+            x = x.reshape(m, q, 4, 3, 4, 3).transpose(1, 2, 4, 0, 3, 5)
+        md = None
         if ddu is not None:
-            jh = np.linalg.det(F)[..., None, None] * np.swapaxes(np.linalg.inv(F), -1, -2)  # J F^-T
-            beta = np.einsum("mqiJ,mqaJ,mq->mai", jh, g, w)
-            k += (ddu / w.sum(axis=1))[:, None, None, None, None] * np.einsum("mai,mbk->maikb", beta, beta)
-        return k
+            j, h = det_and_inverse_transpose(F)
+            md = self._contract(j[..., None, None] * h, el), ddu / w.sum(axis=1)  # beta = int J F^-T G dV
+        return np.ascontiguousarray(e), np.ascontiguousarray(x), md
+
+    def _pair_coefficients(self, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
+        """[C, C'] (P, 2 q 16): C[p, (q, k, l)] = D[q, a_p, k] D[q, b_p, l] and C' the same with k, l exchanged."""
+        d = self.dlam
+        c = (d[:, ia, :, None] * d[:, ib, None, :]).transpose(1, 0, 2, 3)
+        return np.concatenate([c.reshape(len(ia), -1), c.transpose(0, 1, 3, 2).reshape(len(ia), -1)], axis=1)
+
+    def _blocks(self, u_m: np.ndarray, el: slice | np.ndarray, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
+        """Tangent blocks K_ab (P, m, 3, 3) in N/m of the selected elements for the pairs (ia, ib)."""
+        e, x, md = self._point_terms(u_m, el)
+        q, m = e.shape[0], e.shape[3]
+        ex = np.concatenate([e.reshape(q * 16, m * 9), x.reshape(q * 16, m * 9)])
+        blocks = (self._pair_coefficients(ia, ib) @ ex).reshape(len(ia), m, 3, 3)
+        if md is not None:  # the mean dilatation's rank-one volumetric stiffness
+            beta, c = md
+            bi, bj = beta[:, ia].transpose(1, 0, 2), beta[:, ib].transpose(1, 0, 2)
+            blocks += c[None, :, None, None] * bi[..., None] * bj[..., None, :]
+        return blocks
 
     def tangent(self, u_m: np.ndarray, node_index: np.ndarray, n: int) -> UpperBlocks:
         """Tangent stiffness (N/m) at u as upper 3x3 node blocks; node_index maps nodes to block rows
@@ -98,17 +161,19 @@ class Solid:
         ia, ib = upper_pairs(self.mesh.order)
         blocks = np.empty((len(ia), len(self.mesh.elements), 3, 3))
         for s in _chunks(len(self.mesh.elements)):
-            blocks[:, s] = self._element_tangents(u_m, s)[:, ia, :, :, ib]
+            blocks[:, s] = self._blocks(u_m, s, ia, ib)
         return sum_pair_blocks(self.mesh.elements, self.mesh.order, blocks, node_index, n)
 
     def tangent_product(self, u_m: np.ndarray, v_m: np.ndarray) -> np.ndarray:
         """(N, 3) tangent stiffness at u times the nodal vector v (N), from the elements v touches."""
         f = np.zeros((len(self.mesh.nodes_m), 3))
+        nen = self.mesh.elements.shape[1]
+        ia, ib = (x.ravel() for x in np.meshgrid(np.arange(nen), np.arange(nen), indexing="ij"))
         touched = np.flatnonzero(np.any(v_m[self.mesh.elements] != 0, axis=(1, 2)))
         for start in range(0, len(touched), _CHUNK):
             el = touched[start : start + _CHUNK]
-            k = self._element_tangents(u_m, el)
-            _scatter(f, self.mesh.elements[el], np.einsum("maikb,mbk->mai", k, v_m[self.mesh.elements[el]]))
+            k = self._blocks(u_m, el, ia, ib).reshape(nen, nen, len(el), 3, 3)
+            _scatter(f, self.mesh.elements[el], np.einsum("abmik,mbk->mai", k, v_m[self.mesh.elements[el]]))
         return f
 
     def peak_principal_strain(self, u_m: np.ndarray) -> float:

@@ -31,15 +31,23 @@ class _Kinematics:
 
     @classmethod
     def of(cls, F: np.ndarray) -> "_Kinematics":
-        J = np.linalg.det(F)
-        if np.any(J <= 0):
-            raise FloatingPointError("inverted element: det F <= 0")
+        J, H = det_and_inverse_transpose(F)
         C = np.swapaxes(F, -1, -2) @ F
         I1 = np.trace(C, axis1=-2, axis2=-1)
-        I2 = 0.5 * (I1**2 - np.einsum("...ij,...ji->...", C, C))
-        H = np.swapaxes(np.linalg.inv(F), -1, -2)
+        I2 = 0.5 * (I1**2 - np.sum(C * C, axis=(-2, -1)))
         dI2 = 2.0 * (I1[..., None, None] * F - F @ C)
         return cls(F, J, H, I1, I2, C, dI2)
+
+
+def det_and_inverse_transpose(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """det F and F^-T of each F (..., 3, 3) from the cofactors (columns c_i: cof = [c1 x c2, c2 x c0, c0 x c1]);
+    FloatingPointError when an element is inverted (det F <= 0)."""
+    c0, c1, c2 = F[..., :, 0], F[..., :, 1], F[..., :, 2]
+    cof = np.stack([np.cross(c1, c2), np.cross(c2, c0), np.cross(c0, c1)], axis=-1)
+    J = np.sum(c0 * cof[..., :, 0], axis=-1)
+    if np.any(J <= 0):
+        raise FloatingPointError("inverted element: det F <= 0")
+    return J, cof / J[..., None, None]
 
 
 def volumetric(law: Hyperelastic, J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -99,9 +107,59 @@ def _outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., :, :, None, None] * b[..., None, None, :, :]
 
 
+@dataclass(frozen=True)
+class I1Tangent:
+    """dP/dF of a law in I1bar and J only (neo-Hooke, Yeoh), as five scalar fields (...) in Pa:
+    A = delta d_ik d_JL + cross (F_iJ H_kL + H_iJ F_kL) + hh H_iJ H_kL + hx H_iL H_kJ + w11 D_iJ D_kL
+    with H = F^-T and D = dI1bar/dF. A caller that contracts A with gradients uses these terms
+    directly instead of the 81 components."""
+
+    P: np.ndarray
+    F: np.ndarray
+    H: np.ndarray
+    D: np.ndarray
+    delta: np.ndarray
+    cross: np.ndarray
+    hh: np.ndarray
+    hx: np.ndarray
+    w11: np.ndarray
+
+    def full(self) -> np.ndarray:
+        """A (..., 3, 3, 3, 3)."""
+        e4 = (..., None, None, None, None)
+        ii = np.einsum("ik,JL->iJkL", _I, _I)
+        hh = _outer(self.H, self.H)
+        fh = _outer(self.F, self.H)
+        return (self.delta[e4] * ii + self.cross[e4] * (fh + np.swapaxes(np.swapaxes(fh, -4, -2), -3, -1))
+                + self.hh[e4] * hh + self.hx[e4] * np.swapaxes(hh, -3, -1) + self.w11[e4] * _outer(self.D, self.D))
+
+
+def i1_tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> I1Tangent:
+    """The terms of dP/dF for a law without I2bar (law.c01_Pa == 0); `pressure_Pa` as in `tangent`."""
+    if law.c01_Pa:
+        raise ValueError("i1_tangent takes laws in I1bar and J only; use tangent for Mooney-Rivlin")
+    kin = _Kinematics.of(F)
+    i1b, i2b, d1, _ = _first(kin)
+    w1, _, w11, _ = _isochoric(law, i1b, i2b)
+    if pressure_Pa is None:
+        _, wj, wjj = volumetric(law, kin.J)
+    else:
+        wj, wjj = pressure_Pa, np.zeros_like(kin.J)
+    J, I1 = kin.J, kin.I1
+    s = w1 * J ** (-2 / 3)
+    # w1 d2I1bar/dF2 = s (2 d_ik d_JL - 4/3 (F x H + H x F) + 4/9 I1 H x H + 2/3 I1 H_iL H_kJ), plus the volumetric part
+    P = w1[..., None, None] * d1 + (wj * J)[..., None, None] * kin.H
+    return I1Tangent(P, kin.F, kin.H, d1, 2.0 * s, -(4 / 3) * s, (4 / 9) * s * I1 + wjj * J**2 + wj * J,
+                     (2 / 3) * s * I1 - wj * J, w11)
+
+
 def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """P (..., 3, 3) and A = dP/dF (..., 3, 3, 3, 3) with A[..., i, J, k, L] = dP_iJ / dF_kL (Pa).
-    With `pressure_Pa` (U' given, as in `stress`), U'' is left out: the caller adds the volumetric stiffness."""
+    With `pressure_Pa` (U' given, as in `stress`), U'' is left out: the caller adds the volumetric stiffness.
+    Laws without I2bar are built from `i1_tangent`; Mooney-Rivlin from the second derivatives of both invariants."""
+    if not law.c01_Pa:
+        t = i1_tangent(law, F, pressure_Pa)
+        return t.P, t.full()
     kin = _Kinematics.of(F)
     i1b, i2b, d1, d2 = _first(kin)
     w1, w2, w11, w22 = _isochoric(law, i1b, i2b)

@@ -20,6 +20,7 @@ import scipy.sparse as sp
 from seadesign.errors import NotPositiveDefinite, SolverError
 
 _SPD = 2  # PARDISO mtype: real symmetric positive definite
+_SYMMETRIC = -2  # real symmetric indefinite (Bunch-Kaufman), which reports the inertia
 _ERRORS = {
     -2: "not enough memory",
     -3: "reordering failed",
@@ -54,8 +55,10 @@ class Pardiso:
     """Cholesky factorization of an SPD matrix given as its upper triangle: scalar CSR, or BSR
     whose block entries hold col >= row with full diagonal blocks."""
 
-    def __init__(self, upper: sp.csr_matrix | sp.bsr_matrix) -> None:
+    def __init__(self, upper: sp.csr_matrix | sp.bsr_matrix, indefinite: bool = False) -> None:
+        """indefinite=True: an LDL^T factorization of any symmetric matrix, for its `inertia`."""
         self._lib = _library()
+        self._mtype = _SYMMETRIC if indefinite else _SPD
         self.n = upper.shape[0]
         block = upper.blocksize[0] if sp.issparse(upper) and upper.format == "bsr" else 1
         upper.sort_indices()
@@ -65,7 +68,7 @@ class Pardiso:
         self._rows = self.n // block
         self._pt = np.zeros(64, dtype=np.int64)
         self._iparm = np.zeros(64, dtype=np.int32)
-        self._lib.pardisoinit(self._pt.ctypes.data_as(_P(ctypes.c_int64)), ctypes.byref(_I32(_SPD)),
+        self._lib.pardisoinit(self._pt.ctypes.data_as(_P(ctypes.c_int64)), ctypes.byref(_I32(self._mtype)),
                               self._iparm.ctypes.data_as(_P(_I32)))
         self._iparm[34] = 1  # zero-based indices
         self._iparm[36] = block if block > 1 else 0
@@ -78,17 +81,38 @@ class Pardiso:
         nrhs = 1 if b.ndim == 1 else b.shape[1]
         self._lib.pardiso(
             self._pt.ctypes.data_as(_P(ctypes.c_int64)), ctypes.byref(_I32(1)), ctypes.byref(_I32(1)),
-            ctypes.byref(_I32(_SPD)), ctypes.byref(_I32(phase)), ctypes.byref(_I32(self._rows)),
+            ctypes.byref(_I32(self._mtype)), ctypes.byref(_I32(phase)), ctypes.byref(_I32(self._rows)),
             self._data.ctypes.data, self._ia.ctypes.data_as(_P(_I32)), self._ja.ctypes.data_as(_P(_I32)),
             None, ctypes.byref(_I32(nrhs)), self._iparm.ctypes.data_as(_P(_I32)), ctypes.byref(_I32(0)),
             b.ctypes.data, x.ctypes.data, ctypes.byref(err),
         )
         if err.value != 0:
             self.close()
-            if err.value == -4:
+            if err.value == -4 or (err.value == -13 and self._mtype == _SPD and phase in (12, 22) and self._indefinite()):
+                # -13 is what the parallel Cholesky sometimes returns for a negative pivot: confirmed by the inertia
                 raise NotPositiveDefinite(f"PARDISO failed in phase {phase}: {_ERRORS[-4]}")
             raise SolverError(f"PARDISO failed in phase {phase}: {_ERRORS.get(err.value, f'error {err.value}')}")
         return x
+
+    def _indefinite(self) -> bool:
+        """Whether the matrix has a negative eigenvalue (an LDL^T factorization of the same values)."""
+        indptr, indices = self._ia, self._ja
+        block = self.n // self._rows
+        shape = (self.n, self.n)
+        upper = (sp.bsr_matrix((self._data, indices, indptr), shape=shape) if block > 1
+                 else sp.csr_matrix((self._data, indices, indptr), shape=shape))
+        ldl = Pardiso(upper, indefinite=True)
+        try:
+            return ldl.inertia()[1] > 0
+        finally:
+            ldl.close()
+
+    def inertia(self) -> tuple[int, int, int]:
+        """(positive, negative eigenvalues, perturbed pivots) of an indefinite factorization; with no
+        perturbed pivots the counts are exact (Sylvester's law of inertia on L D L^T)."""
+        if self._mtype != _SYMMETRIC:
+            raise SolverError("inertia needs Pardiso(..., indefinite=True)")
+        return int(self._iparm[21]), int(self._iparm[22]), int(self._iparm[13])
 
     def refactor(self, upper: sp.csr_matrix | sp.bsr_matrix) -> None:
         """Factor new values on the same sparsity pattern, reusing the ordering and symbolic analysis."""

@@ -9,13 +9,15 @@ and retried from the last converged state, never accepted.
 
 The path stops, and says why (`STOP_REASONS` of `design.spring`):
 - target_reached: T reached the target torque;
-- limit_point: T passed a maximum below the target (dT/dtheta <= 0): the torque-driven spring
-  snaps through there; the reported stop is the maximum;
-- bifurcation: the tangent stiffness of the free nodes lost positive definiteness (its smallest
-  eigenvalue reached zero: a buckling mode), located by bisection to `locate_tol_rad`;
-- contact: two surface points that start apart (more than `contact_exclusion_mm`) come closer
-  than `contact_gap_mm`;
+- limit_point: T passed a maximum below the target (dT/dtheta <= 0) while the free nodes' tangent
+  stays positive definite: the torque-driven spring snaps through there; the stop is the maximum;
+- bifurcation: the free nodes' tangent stiffness lost positive definiteness (an eigenvalue crossed
+  zero, counted by its inertia: a buckling mode); both are located by bisection to `locate_tol_rad`;
+- contact: two facing surfaces (outward normals opposed by more than 120 degrees) come closer
+  than `contact_gap_mm` (the notch beside a beam's root closing, a beam reaching its neighbour);
+  the model has no contact forces, so the path ends there, interpolated to the tolerance;
 - strain_limit: the peak principal engineering strain passed the allowable strain;
+- rotation_limit: the rotation reached `max_rotation_rad` below the target torque;
 - unconverged: the increment fell below `min_step_rad` without convergence (never a capacity).
 SI units throughout; mesh coordinates arrive in mm.
 """
@@ -46,10 +48,10 @@ class PathSettings:
     min_step_rad: float = 1e-4
     max_rotation_rad: float = 6.0
     max_iterations: int = 12
-    force_rtol: float = 1e-8  # residual norm over the norm of the reaction forces
+    force_rtol: float = 1e-7  # residual norm over the norm of the reaction forces
     locate_tol_rad: float = 1e-3  # bisection tolerance of a bifurcation's rotation
-    contact_gap_mm: float = 0.05
-    contact_exclusion_mm: float = 2.0  # surface points closer than this at rest never count as contact
+    contact_gap_mm: float = 0.1  # a quarter of an extrusion width: printed faces are not truer than that
+    contact_search_mm: float = 0.5  # below the thinnest feature: faces further apart are never checked
     allowable_strain: float | None = None  # engineering strain; None: no strain stop
 
 
@@ -61,7 +63,7 @@ class PathPoint:
     torque_Nm: float
     tangent_Nm_per_rad: float  # dT/dtheta
     peak_strain: float  # largest principal engineering strain (max stretch - 1) at the quadrature points
-    min_gap_mm: float  # smallest distance between surface points that start apart (inf: none within range)
+    min_gap_mm: float  # smallest gap between facing surfaces (mm; inf: none within the search distance)
     iterations: int
     residual_norms_N: tuple[float, ...]
 
@@ -104,10 +106,13 @@ class _Problem:
     hub: np.ndarray
     free: np.ndarray
     node_index: np.ndarray
-    surface: np.ndarray
+    surface: np.ndarray  # boundary vertices (contact is checked on the linear facets)
+    boundary_faces: np.ndarray
+    rest_normals: np.ndarray  # outward unit normals of the boundary vertices at rest
     settings: PathSettings
     dof_free: np.ndarray  # (n_free, 3) 1.0 for a free degree of freedom of a free node, 0.0 for one held at zero
     pardiso: Pardiso | None = None
+    factored_at: np.ndarray | None = None  # the state of the current factorization within this increment
 
     def residual(self, f: np.ndarray) -> np.ndarray:
         """The out-of-balance forces (N) on the free degrees of freedom, flattened."""
@@ -131,23 +136,28 @@ class _Problem:
         return float(np.sum(xd[:, 0] * fh[:, 1] - xd[:, 1] * fh[:, 0]))
 
     def factor(self, u: np.ndarray) -> Pardiso:
-        """Factorization of the free-node tangent at u (NotPositiveDefinite when it has lost stability)."""
+        """LDL^T factorization of the free-node tangent at u; NotPositiveDefinite when its inertia counts a
+        negative eigenvalue (the state has lost stability). The inertia is exact, where a Cholesky
+        factorization near a singular point may or may not meet its negative pivot."""
         k = self.solid.tangent(u, self.node_index, len(self.free))
-        if not self.dof_free.all():  # held degrees of freedom: zero rows and columns, unit diagonal
+        self._hold(k)
+        k = k.matrix()
+        if self.pardiso is not None and self.pardiso._alive:
+            self.pardiso.refactor(k)
+        else:
+            self.pardiso = Pardiso(k, indefinite=True)
+        self.factored_at = u
+        if self.pardiso.inertia()[1] > 0:
+            raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
+        return self.pardiso
+
+    def _hold(self, k) -> None:
+        """Held degrees of freedom: zero rows and columns, unit diagonal (in place)."""
+        if not self.dof_free.all():
             m = self.dof_free
             k.values[:] *= m[k.rows][:, :, None] * m[k.cols][:, None, :]
             diag = k.rows == k.cols
             k.values[diag] += np.eye(3) * (1.0 - m[k.rows[diag]])[:, None, :]
-        k = k.matrix()
-        if self.pardiso is not None and self.pardiso._alive:
-            try:
-                self.pardiso.refactor(k)
-                return self.pardiso
-            except NotPositiveDefinite:
-                self.pardiso = None
-                raise
-        self.pardiso = Pardiso(k)
-        return self.pardiso
 
     def close(self) -> None:
         if self.pardiso is not None:
@@ -170,25 +180,41 @@ def _hermite_inverse(a: PathPoint, b: PathPoint, torque_Nm: float) -> float:
     return a.rotation_rad + 0.5 * (lo + hi) * (b.rotation_rad - a.rotation_rad)
 
 
+def _vertex_normals(x: np.ndarray, faces: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """Unit outward normals (area-weighted) of the boundary vertices at positions x."""
+    tri = x[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    vn = np.zeros_like(x)
+    for k in range(3):
+        np.add.at(vn, faces[:, k], normal)
+    return vn[vertices] / np.linalg.norm(vn[vertices], axis=1)[:, None]
+
+
+def _gap(x: np.ndarray, n: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """Separation of vertex pairs along their normals (m); positive across open space, negative through material."""
+    d = x[pairs[:, 1]] - x[pairs[:, 0]]
+    return 0.5 * np.einsum("ij,ij->i", d, n[pairs[:, 0]] - n[pairs[:, 1]])
+
+
 def _min_gap_mm(p: _Problem, u: np.ndarray) -> float:
-    """Smallest deformed distance (mm) between surface nodes that were further apart than the exclusion at rest."""
-    s = p.settings
-    xd = p.solid.mesh.nodes_m[p.surface] + u[p.surface]
-    tree = cKDTree(xd)
-    search = max(4.0 * s.contact_gap_mm, 0.5) * MM
-    pairs = tree.query_pairs(search, output_type="ndarray")
-    if len(pairs) == 0:
-        return float("inf")
+    """Smallest gap (mm) between facing boundary vertices of the deformed part: pairs within the search
+    distance whose outward normals are opposed (cosine < -0.5) and that faced each other across open
+    space at rest (not the two sides of a thin wall); the gap is their separation along the normals,
+    negative once they overlap."""
     x0 = p.solid.mesh.nodes_m[p.surface]
-    apart = np.linalg.norm(x0[pairs[:, 0]] - x0[pairs[:, 1]], axis=1) > s.contact_exclusion_mm * MM
-    if not apart.any():
-        return float("inf")
-    pairs = pairs[apart]
-    return float(np.linalg.norm(xd[pairs[:, 0]] - xd[pairs[:, 1]], axis=1).min() / MM)
+    x = x0 + u[p.surface]
+    n = _vertex_normals(p.solid.mesh.nodes_m + u, p.boundary_faces, p.surface)
+    pairs = cKDTree(x).query_pairs(p.settings.contact_search_mm * MM, output_type="ndarray")
+    if len(pairs):
+        pairs = pairs[np.einsum("ij,ij->i", n[pairs[:, 0]], n[pairs[:, 1]]) < -0.5]
+    if len(pairs):
+        pairs = pairs[_gap(x0, p.rest_normals, pairs) > 0]
+    return float(_gap(x, n, pairs).min() / MM) if len(pairs) else float("inf")
 
 
-def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, list[float], bool]:
-    """Equilibrium of the free nodes at hub rotation theta from the guess u0: (u, residual norms, converged)."""
+def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, list[float], str]:
+    """Equilibrium of the free nodes at hub rotation theta from the guess u0: (u, residual norms, status)
+    with status "converged", "unstable" (a tangent that is not positive definite) or "failed"."""
     s = p.settings
     u = u0.copy()
     u[p.hub] = p.hub_displacement(theta)
@@ -196,43 +222,45 @@ def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, list
     try:
         f = p.solid.forces(u)
     except FloatingPointError:
-        return u, norms, False
+        return u, norms, "failed"
+    p.factored_at = None
     for _ in range(s.max_iterations):
         r = p.residual(f)
         scale = max(np.linalg.norm(f[p.hub]), 1e-12)
         norms.append(float(np.linalg.norm(r)))
         if norms[-1] <= s.force_rtol * scale:
-            return u, norms, True
+            return u, norms, "converged"
         try:
             du = -p.factor(u).solve(r).reshape(-1, 3)
-        except (NotPositiveDefinite, FloatingPointError):
-            return u, norms, False
-        e0, slope = p.solid.energy(u), float(r @ du.ravel())
+        except NotPositiveDefinite:
+            return u, norms, "unstable"
+        e0, slope = None, float(r @ du.ravel())
         alpha = 1.0
         while alpha > 1e-3:
             trial = u.copy()
             trial[p.free] += alpha * du
             try:
-                e1 = p.solid.energy(trial)
                 f1 = p.solid.forces(trial)
+                # accept when the residual falls, else when the energy falls as Armijo asks
+                if np.linalg.norm(p.residual(f1)) < norms[-1]:
+                    break
+                e0 = p.solid.energy(u) if e0 is None else e0
+                if p.solid.energy(trial) <= e0 + 1e-4 * alpha * slope:
+                    break
             except FloatingPointError:  # an element inverted: shorten the step
-                alpha *= 0.5
-                continue
-            # accept when the energy falls as Armijo asks, or (near convergence, where energies
-            # differ by round-off) when the residual falls
-            if e1 <= e0 + 1e-4 * alpha * slope or np.linalg.norm(p.residual(f1)) < norms[-1]:
-                break
+                pass
             alpha *= 0.5
         else:
-            return u, norms, False
+            return u, norms, "failed"
         u, f = trial, f1
     norms.append(float(np.linalg.norm(p.residual(f))))
-    return u, norms, norms[-1] <= s.force_rtol * max(np.linalg.norm(f[p.hub]), 1e-12)
+    return u, norms, "converged" if norms[-1] <= s.force_rtol * max(np.linalg.norm(f[p.hub]), 1e-12) else "failed"
 
 
 def _state(p: _Problem, u: np.ndarray, theta: float, iterations: int, norms: list[float]) -> tuple[PathPoint, np.ndarray]:
-    """The converged point at u and the path's direction du/dtheta there (NotPositiveDefinite: unstable)."""
-    fac = p.factor(u)
+    """The converged point at u and the path's direction du/dtheta there (NotPositiveDefinite: unstable).
+    The tangent is the last Newton iteration's (within the residual tolerance of u), else factored at u."""
+    fac = p.pardiso if p.factored_at is not None else p.factor(u)
     v = np.zeros_like(u)
     v[p.hub] = p.hub_velocity(theta)
     v[p.free] = -fac.solve(p.residual(p.solid.tangent_product(u, v))).reshape(-1, 3)
@@ -262,26 +290,30 @@ def _problem(mesh: TetMesh, law: Hyperelastic, settings: PathSettings, order: in
     free = np.setdiff1d(np.arange(len(emesh.nodes_m)), prescribed)
     index = np.full(len(emesh.nodes_m), -1, dtype=np.int64)
     index[free] = np.arange(len(free))
-    surface = surface_nodes(emesh, mesh.boundary_faces)
+    surface = np.unique(mesh.boundary_faces)
     dof_free = np.ones((len(free), 3))
     if axially_held_faces is not None:
         held = index[surface_nodes(emesh, axially_held_faces)]
         dof_free[held[held >= 0], 2] = 0.0
-    return _Problem(Solid.of(emesh, law, formulation), hub, free, index, surface, settings, dof_free)
+    rest_normals = _vertex_normals(emesh.nodes_m, mesh.boundary_faces, surface)
+    return _Problem(Solid.of(emesh, law, formulation), hub, free, index, surface, mesh.boundary_faces, rest_normals,
+                    settings, dof_free)
 
 
 def _stop_check(p: _Problem, prev: PathPoint, point: PathPoint, target_Nm: float) -> str | None:
+    """Why the path stops at `point`, if it does; events that end the curve before the target come first,
+    so that the one met first is located (the caller cuts the step until it is)."""
     s = p.settings
-    if point.torque_Nm >= target_Nm:
-        return "target_reached"
     if point.tangent_Nm_per_rad <= 0 or point.torque_Nm <= prev.torque_Nm:
         return "limit_point"
     if point.min_gap_mm < s.contact_gap_mm:
         return "contact"
     if s.allowable_strain is not None and point.peak_strain > s.allowable_strain:
         return "strain_limit"
+    if point.torque_Nm >= target_Nm:
+        return "target_reached"
     if point.rotation_rad >= s.max_rotation_rad:
-        return "unconverged"
+        return "rotation_limit"
     return None
 
 
@@ -312,31 +344,32 @@ def rotation_path(
             last = points[-1]
             step = min(step, settings.max_step_rad, settings.max_rotation_rad - last.rotation_rad)
             theta = last.rotation_rad + step
-            trial, norms, ok = _newton(p, _predict(p, u, v, step, previous, last.rotation_rad), theta)
-            point = None
-            if ok:
+            trial, norms, status = _newton(p, _predict(p, u, v, step, previous, last.rotation_rad), theta)
+            event = None
+            if status == "converged":
                 try:
                     point, v_new = _state(p, trial, theta, len(norms) - 1, norms)
+                    event = _stop_check(p, last, point, target_torque_Nm)
                 except NotPositiveDefinite:
-                    if step <= settings.locate_tol_rad:
-                        reason = "bifurcation"
-                        break
-            if point is None:
+                    status = "unstable"
+            located = step <= settings.locate_tol_rad
+            if status == "unstable" and located:
+                reason = "bifurcation"
+            elif status != "converged" or (event not in (None, "target_reached") and not located):
+                # not converged, or an event (limit point, contact, strain limit) to be located more closely
                 cuts += 1
                 step *= 0.5
-                if ok or step >= settings.min_step_rad:
-                    continue
-                reason = "unconverged"
-                break
-            points.append(point)
-            previous = (u, last.rotation_rad)
-            u, v = trial, v_new
-            reason = _stop_check(p, last, point, target_torque_Nm)
-            if len(norms) <= 5:
-                step *= 1.5
+                if status == "failed" and step < settings.min_step_rad:
+                    reason = "unconverged"
+            else:
+                points.append(point)
+                previous = (u, last.rotation_rad)
+                u, v, reason = trial, v_new, event
+                if len(norms) <= 5:
+                    step *= 1.5
     finally:
         p.close()
-    stop_theta, stop_torque = _stop_point(points, reason, target_torque_Nm)
+    stop_theta, stop_torque = _stop_point(points, reason, target_torque_Nm, settings.contact_gap_mm)
     return TorquePath(tuple(points), reason, stop_theta, stop_torque, u, p.solid.mesh, cuts, time.perf_counter() - t0)
 
 
@@ -359,8 +392,9 @@ def _predict(p: _Problem, u: np.ndarray, v: np.ndarray, step: float,
     return u + swirl + rest * step
 
 
-def _stop_point(points: list[PathPoint], reason: str, target_Nm: float) -> tuple[float, float]:
-    """Where the path stops: the target torque's rotation, the torque maximum of a limit point, else the last point."""
+def _stop_point(points: list[PathPoint], reason: str, target_Nm: float, gap_mm: float) -> tuple[float, float]:
+    """Where the path stops: the target torque's rotation, the torque maximum of a limit point, contact
+    where the gap (linear between the last two points) reaches `gap_mm`, else the last point."""
     last = points[-1]
     if reason == "target_reached" and len(points) > 1:
         return _hermite_inverse(points[-2], last, target_Nm), target_Nm
@@ -370,4 +404,8 @@ def _stop_point(points: list[PathPoint], reason: str, target_Nm: float) -> tuple
         t = _hermite(a, b, s)
         i = int(np.argmax(t))
         return a.rotation_rad + s[i] * (b.rotation_rad - a.rotation_rad), float(t[i])
+    if reason == "contact" and len(points) > 1 and np.isfinite(points[-2].min_gap_mm):
+        a, b = points[-2], last
+        s = float(np.clip((a.min_gap_mm - gap_mm) / (a.min_gap_mm - b.min_gap_mm), 0.0, 1.0))
+        return a.rotation_rad + s * (b.rotation_rad - a.rotation_rad), float(_hermite(a, b, s))
     return last.rotation_rad, last.torque_Nm

@@ -1,0 +1,119 @@
+"""The rotation-driven large-deflection path against independent references: Rivlin's circular shear
+of an incompressible neo-Hookean annulus, the linear solver's stiffness at rest with the same hub
+constraints, and the eigenvalues of the tangent where the path says a buckling mode appears."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse.linalg as sla
+from helpers_annulus import annulus_mesh
+
+from seadesign.design.materials import Hyperelastic
+from seadesign.fea.assembly import stiffness_upper
+from seadesign.fea.couplings import couple
+from seadesign.fea.linsolve import full_from_upper
+from seadesign.fea.rotation_path import PathSettings, _problem, rotation_path
+from seadesign.fea.torsion import MM, surface_nodes
+
+A_MM, B_MM, H_MM, E = 10.0, 20.0, 4.0, 12e6
+
+
+def _circular_shear(n_r: int, n_theta: int, nu: float, formulation: str):
+    """Path to the torque of 1 rad in Rivlin's solution, faces held axially (u_z = 0, plane strain)."""
+    mesh = annulus_mesh(A_MM, B_MM, H_MM, n_r, n_theta, 1)
+    z = mesh.points_mm[mesh.boundary_faces][:, :, 2]
+    faces = mesh.boundary_faces[np.all(z < 1e-6, axis=1) | np.all(z > H_MM - 1e-6, axis=1)]
+    mu = E / (2 * (1 + nu))
+    t1 = 4 * np.pi * mu * H_MM * MM / ((A_MM * MM) ** -2 - (B_MM * MM) ** -2)  # T at phi(a) = 1 rad
+    path = rotation_path(mesh, Hyperelastic.from_linear(E, nu), 1.001 * t1, PathSettings(max_step_rad=0.25),
+                         axially_held_faces=faces, formulation=formulation)
+    return path, t1, mu
+
+
+def _radial_drift(path) -> np.ndarray:
+    """|r' - r| of every vertex over the hub's arc at the last rotation."""
+    x0, u = path.emesh.nodes_m[: path.emesh.n_vertices], path.displacement_m[: path.emesh.n_vertices]
+    dr = np.hypot(*(x0 + u)[:, :2].T) - np.hypot(*x0[:, :2].T)
+    return np.abs(dr) / (A_MM * MM * path.points[-1].rotation_rad)
+
+
+def test_circular_shear_torque_stays_linear_to_one_radian():
+    # Rivlin: phi(a) = T / (4 pi mu h) (1/a^2 - 1/b^2) at any rotation (the shear response of neo-Hooke is linear)
+    path, t1, _ = _circular_shear(4, 48, 0.4999, "mean_dilatation")
+    assert path.stop_reason == "target_reached"
+    assert path.rotation_at(t1) == pytest.approx(1.0, abs=0.01)  # measured 0.9964 on this coarse mesh
+    for p in path.points[1:]:
+        assert p.torque_Nm == pytest.approx(t1 * p.rotation_rad, rel=0.01)
+    assert _radial_drift(path).max() < 0.01  # measured 0.0044 (0.0011 on 10 x 120, second order)
+
+
+def test_full_integration_locks_near_incompressibility():
+    # the displacement-only P2 element with U(J) at every point is 7 % too stiff at 1 rad for nu = 0.4999;
+    # the mean dilatation (one pressure per element) is not: the formulation that keeps P2 free of locking
+    path, t1, _ = _circular_shear(4, 48, 0.4999, "full")
+    assert path.rotation_at(t1) < 0.97  # measured 0.942
+
+
+@pytest.mark.slow
+def test_circular_shear_keeps_points_on_circles_and_the_normal_stress_difference():
+    from seadesign.fea.finite_strain import Solid
+    from seadesign.fea.hyperelastic import stress
+
+    path, t1, mu = _circular_shear(12, 144, 0.4999, "mean_dilatation")
+    assert path.rotation_at(t1) == pytest.approx(1.0, abs=1e-3)
+    assert _radial_drift(path).max() < 1e-3  # points stay on their circles: < 0.1 % of the arc at 1 rad
+    # sigma_tt - sigma_rr = mu gamma^2, gamma = T / (2 pi mu h r^2), averaged over rings of the deformed annulus
+    solid = Solid.of(path.emesh, Hyperelastic.from_linear(E, 0.4999), "mean_dilatation")
+    u = path.displacement_m
+    F = solid.deformation_gradient(u)
+    sig = stress(solid.law, F) @ np.swapaxes(F, -1, -2) / np.linalg.det(F)[..., None, None]
+    from seadesign.fea.elements import quadrature, shape_values
+
+    n = shape_values(2, quadrature(2)[0])
+    x = np.einsum("qa,mai->mqi", n, (path.emesh.nodes_m + u)[path.emesh.elements])
+    ang = np.arctan2(x[..., 1], x[..., 0])
+    er = np.stack([np.cos(ang), np.sin(ang), 0 * ang], -1)
+    et = np.stack([-np.sin(ang), np.cos(ang), 0 * ang], -1)
+    diff = np.einsum("mqi,mqij,mqj->mq", et, sig, et) - np.einsum("mqi,mqij,mqj->mq", er, sig, er)
+    r = np.hypot(x[..., 0], x[..., 1])
+    gamma = path.points[-1].torque_Nm / (2 * np.pi * mu * H_MM * MM * r**2)
+    bins = np.digitize(r, np.linspace(11e-3, 19e-3, 9))
+    for k in range(1, 9):
+        ring = bins == k
+        assert diff[ring].mean() == pytest.approx((mu * gamma[ring] ** 2).mean(), rel=0.02)
+
+
+def test_tangent_at_rest_equals_the_linear_k_with_the_same_hub_constraints():
+    # the linear solver's rigid coupling with the hub's translation and tilt held: k = 1 / (K^-1)_zz
+    mesh = annulus_mesh(5.0, 12.0, 3.0, n_r=2, n_theta=12, n_z=2)
+    mesh = annulus_mesh(5.0, 12.0, 3.0, n_r=3, n_theta=16, n_z=2)
+    path = rotation_path(mesh, Hyperelastic.from_linear(E, 0.48), 1e-3)
+    p = _problem(mesh, Hyperelastic.from_linear(E, 0.48), PathSettings(), 2, None, None, None, "full")
+    em = p.solid.mesh
+    ring = np.setdiff1d(np.flatnonzero(p.node_index < 0), p.hub)
+    cpl = couple(em.nodes_m, p.hub, ring, np.array([0.0, 0.0, 1.5e-3]))
+    k = full_from_upper(cpl.condense(stiffness_upper(em, E, 0.48, cpl.node_index, cpl.n_rows)).matrix()).tocsc()
+    keep = np.setdiff1d(np.arange(k.shape[0]), cpl.ref_dofs[:5])  # hold t and the tilts
+    rhs = np.zeros(len(keep))
+    rhs[-1] = 1.0
+    theta = sla.spsolve(k[keep][:, keep], rhs)[-1]
+    assert path.points[0].tangent_Nm_per_rad == pytest.approx(1.0 / theta, rel=1e-9)  # measured 2e-12
+
+
+def test_a_thin_plate_in_torsion_stops_where_the_tangent_loses_stability():
+    # a 0.3 mm annular plate wrinkles under torsion: the path must stop as a bifurcation, with the
+    # smallest eigenvalue of the free nodes' tangent (scipy, shift-invert) near zero there and positive at rest
+    mesh = annulus_mesh(10.0, 20.0, 0.3, 4, 48, 1)
+    law = Hyperelastic.from_linear(E, 0.45)
+    path = rotation_path(mesh, law, 50.0, PathSettings(max_step_rad=0.05))
+    assert path.stop_reason == "bifurcation"
+    p = _problem(mesh, law, PathSettings(), 2, None, None, None, "full")
+
+    def smallest(u):
+        k = full_from_upper(p.solid.tangent(u, p.node_index, len(p.free)).matrix()).tocsc()
+        return sla.eigsh(k, k=1, sigma=0, which="LM", return_eigenvectors=False)[0]
+
+    at_rest, at_stop = smallest(np.zeros_like(path.displacement_m)), smallest(path.displacement_m)
+    assert at_rest > 0 and 0 < at_stop < 0.05 * at_rest
+    assert path.points[-1].tangent_Nm_per_rad > 0.9 * path.points[0].tangent_Nm_per_rad  # no torque maximum
