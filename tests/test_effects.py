@@ -34,12 +34,18 @@ def _signals():
             "stance": 0.5 + 0.5 * np.sin(T), "hall": 1.0 + D, "temperature": 30.0 + T, "effort": 9.1 * D}
 
 
+# parameters that exercise each stateful effect's regime on the 20 s record: a step in mid-record, thermal
+# softening that heats and cools by tens of percent, a hysteresis loop that saturates
+STEPPING = {"sensor_step": {"time_s": 7.31, "size_rad": 0.09}, "thermal_softening": {"softening_per_J": 0.5,
+            "cooling_time_s": 3.0}, "hysteresis": {"torque_Nm": 0.3, "stiffness_Nm_per_rad": 20.0}}
+
+
 @pytest.mark.parametrize("key", sorted(k for k, c in LIBRARY.items() if c.stateful))
 @pytest.mark.parametrize("uniform", [True, False], ids=["uniform", "jittered"])
 def test_stepping_equals_apply(key, uniform):
     """Stateful effects have two implementations (per-sample `step`, vectorised `apply`): they must agree,
     on a uniform time grid (the vectorised filters) and a jittered one (the per-sample fallbacks)."""
-    effect = LIBRARY[key]()
+    effect = LIBRARY[key](**STEPPING.get(key, {}))
     sig = _signals()
     if not uniform:
         sig["time"] = T + np.random.default_rng(1).uniform(0, 0.004, T.size)
@@ -50,6 +56,8 @@ def test_stepping_equals_apply(key, uniform):
     stepped = [effect.step(state, {k: v[i:i + 1] for k, v in sig.items()}, T_[i] - T_[i - 1] if i else 0.0)[0]
                for i in range(T.size)]
     np.testing.assert_allclose(stepped, whole, atol=1e-12)
+    if key in STEPPING:  # the regime is reached: the effect changes its target by more than a trace
+        assert np.abs(whole - sig[effect.target()]).max() > 0.05
 
 
 def test_every_parameter_has_unit_and_sane_bounds():
