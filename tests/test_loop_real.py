@@ -26,7 +26,7 @@ ROWS = {
     ("free_dtest_part1", "l"): (["stiffness_scale", "sensor_drift"], ["backlash", "gear_friction"], 0.1119, 0.08433),
     ("free_dtest_part1", "r"): (["stiffness_scale", "sensor_delay", "hysteresis"], ["backlash"], 0.1601, 0.07468),
     ("ground_dtest_part1", "l"): (["sensor_offset", "sensor_step", "sensor_step_2", "hysteresis"], ["backlash"],
-                                  1.483, 0.0992),
+                                  1.483, 0.1003),
     ("ground_dtest_part1", "r"): (["stiffness_scale", "sensor_offset", "hysteresis", "sensor_step", "sensor_step_2"],
                                   ["backlash", "gear_friction"], 1.093, 0.1311),
     ("d1free", "l"): (["stiffness_scale"], ["backlash", "gear_friction"], 0.01644, 0.005232),
