@@ -32,7 +32,8 @@ a chain holding only A (`chain.configure("B", enabled=False)`).
 
 from seadesign.effects.base import SIGNALS, Effect, Param, Scales, lowpass, lowpass_uniform
 from seadesign.effects.chain import EffectChain, effect_rng
-from seadesign.effects.curve import CurveRangeError, SpringCurve, TorqueCurve
+from seadesign.design.spring import CurveRangeError, TorqueCurve
+from seadesign.effects.curve import SpringCurve
 from seadesign.effects.load import Friction, GravityLoad, StanceLoad
 from seadesign.effects.sensor import (
     AngleWrap,

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from seadesign.design.spring import CurveRangeError, TorqueCurve
+from seadesign.design.spring import TorqueCurve
 from seadesign.effects.base import Effect, Param, Scales, Search
 
 

@@ -134,6 +134,13 @@ class I1Tangent:
                 + self.hh[e4] * hh + self.hx[e4] * np.swapaxes(hh, -3, -1) + self.w11[e4] * _outer(self.D, self.D))
 
 
+def _volumetric_slopes(law: Hyperelastic, J: np.ndarray, pressure_Pa: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """U'(J) and U''(J) (Pa), or the given pressure with no U'' (the caller adds the volumetric stiffness)."""
+    if pressure_Pa is None:
+        return volumetric(law, J)[1:]
+    return pressure_Pa, np.zeros_like(J)
+
+
 def i1_tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> I1Tangent:
     """The terms of dP/dF for a law without I2bar (law.c01_Pa == 0); `pressure_Pa` as in `tangent`."""
     if law.c01_Pa:
@@ -141,10 +148,7 @@ def i1_tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None 
     kin = _Kinematics.of(F)
     i1b, i2b, d1, _ = _first(kin)
     w1, _, w11, _ = _isochoric(law, i1b, i2b)
-    if pressure_Pa is None:
-        _, wj, wjj = volumetric(law, kin.J)
-    else:
-        wj, wjj = pressure_Pa, np.zeros_like(kin.J)
+    wj, wjj = _volumetric_slopes(law, kin.J, pressure_Pa)
     J, I1 = kin.J, kin.I1
     s = w1 * J ** (-2 / 3)
     # w1 d2I1bar/dF2 = s (2 d_ik d_JL - 4/3 (F x H + H x F) + 4/9 I1 H x H + 2/3 I1 H_iL H_kJ), plus the volumetric part
@@ -163,10 +167,7 @@ def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = N
     kin = _Kinematics.of(F)
     i1b, i2b, d1, d2 = _first(kin)
     w1, w2, w11, w22 = _isochoric(law, i1b, i2b)
-    if pressure_Pa is None:
-        _, wj, wjj = volumetric(law, kin.J)
-    else:
-        wj, wjj = pressure_Pa, np.zeros_like(kin.J)
+    wj, wjj = _volumetric_slopes(law, kin.J, pressure_Pa)
     F, H, J, I1, I2 = kin.F, kin.H, kin.J, kin.I1, kin.I2
     e, e4 = (..., None, None), (..., None, None, None, None)
     hh = _outer(H, H)  # H_iJ H_kL
