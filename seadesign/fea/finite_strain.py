@@ -31,15 +31,14 @@ class Solid:
 
     Shape-function gradients are combinations of the element's constant barycentric gradients
     (straight-sided elements): G_a(x_q) = sum_k D[q, a, k] Gamma_k with D (q, nen, 4) the same for
-    every element. `bary` holds Gamma (m, 4, 3) in 1/m, `grads` G (m, q, nen, 3) in 1/m, and
-    `weights_m3` the quadrature weights times volume (m, q) in m^3.
+    every element. `bary` holds Gamma (m, 4, 3) in 1/m and `weights_m3` the quadrature weights times
+    volume (m, q) in m^3.
     """
 
     mesh: ElementMesh
     law: Hyperelastic
     dlam: np.ndarray
     bary: np.ndarray
-    grads: np.ndarray
     weights_m3: np.ndarray
     formulation: str = "full"
 
@@ -50,7 +49,7 @@ class Solid:
         qlam, qw = quadrature(2 if mesh.order == 2 else 1)
         dlam = shape_dlam(mesh.order, qlam)  # (q, nen, 4)
         g, vol = barycentric_gradients(mesh.nodes_m, mesh.elements)
-        return cls(mesh, law, dlam, g, np.einsum("qak,mki->mqai", dlam, g), vol[:, None] * qw[None, :], formulation)
+        return cls(mesh, law, dlam, g, vol[:, None] * qw[None, :], formulation)
 
     def deformation_gradient(self, u_m: np.ndarray, elements: slice | np.ndarray = slice(None)) -> np.ndarray:
         """F = I + grad u (m, q, 3, 3) at the quadrature points of the selected elements: the element's
@@ -61,11 +60,11 @@ class Solid:
         uk = (d @ ue.transpose(1, 0, 2).reshape(nen, -1)).reshape(q, 4, len(ue), 3)  # sum_a D[q, a, k] u_ai
         return np.eye(3) + uk.transpose(2, 0, 3, 1) @ self.bary[elements][:, None]
 
-    def _pressure(self, F: np.ndarray, w: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray]:
-        """Mean dilatation: U'(Jbar) per point (m, q), U''(Jbar) per element and Jbar; full: None, None, J."""
-        J = det_and_inverse_transpose(F)[0]
+    def _mean_dilatation(self, F: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """U'(Jbar) per point (m, q), U''(Jbar) and Jbar per element; None for the full formulation."""
         if self.formulation == "full":
-            return None, None, J
+            return None
+        J = det_and_inverse_transpose(F)[0]
         jbar = (J * w).sum(axis=1) / w.sum(axis=1)
         _, du, ddu = volumetric(self.law, jbar)
         return np.broadcast_to(du[:, None], J.shape), ddu, jbar
@@ -76,8 +75,11 @@ class Solid:
         for s in _chunks(len(self.mesh.elements)):
             F, w = self.deformation_gradient(u_m, s), self.weights_m3[s]
             total += float(np.sum(isochoric_energy_density(self.law, F) * w))
-            _, _, j = self._pressure(F, w)
-            total += float(np.sum(volumetric(self.law, j)[0] * (w if j.ndim == 2 else w.sum(axis=1))))
+            md = self._mean_dilatation(F, w)
+            if md is None:
+                total += float(np.sum(volumetric(self.law, det_and_inverse_transpose(F)[0])[0] * w))
+            else:
+                total += float(np.sum(volumetric(self.law, md[2])[0] * w.sum(axis=1)))
         return total
 
     def forces(self, u_m: np.ndarray) -> np.ndarray:
@@ -85,7 +87,8 @@ class Solid:
         f = np.zeros((len(self.mesh.nodes_m), 3))
         for s in _chunks(len(self.mesh.elements)):
             F = self.deformation_gradient(u_m, s)
-            p = stress(self.law, F, self._pressure(F, self.weights_m3[s])[0])
+            md = self._mean_dilatation(F, self.weights_m3[s])
+            p = stress(self.law, F, None if md is None else md[0])
             _scatter(f, self.mesh.elements[s], self._contract(p, s))
         return f
 
@@ -105,7 +108,8 @@ class Solid:
         (`hyperelastic.I1Tangent`) as outer products of F Gamma, H Gamma and D Gamma, never the 81-component
         A. Also, for the mean dilatation, beta = dv/du (m, nen, 3) and U''(Jbar) / V (m,), else None."""
         F, w, gam = self.deformation_gradient(u_m, el), self.weights_m3[el], self.bary[el]
-        pressure, ddu, _ = self._pressure(F, w)
+        md = self._mean_dilatation(F, w)
+        pressure = None if md is None else md[0]
         m, q = w.shape
         if self.law.c01_Pa:
             _, a = tangent(self.law, F, pressure)
@@ -131,11 +135,11 @@ class Solid:
             x = (((t.hx * w)[..., None, None] * hg).reshape(m * q, 12, 1) @ hg.reshape(m * q, 1, 12))
             e = e.transpose(1, 2, 4, 0, 3, 5)
             x = x.reshape(m, q, 4, 3, 4, 3).transpose(1, 2, 4, 0, 3, 5)
-        md = None
-        if ddu is not None:
+        volumetric_terms = None
+        if md is not None:
             j, h = det_and_inverse_transpose(F)
-            md = self._contract(j[..., None, None] * h, el), ddu / w.sum(axis=1)  # beta = int J F^-T G dV
-        return np.ascontiguousarray(e), np.ascontiguousarray(x), md
+            volumetric_terms = self._contract(j[..., None, None] * h, el), md[1] / w.sum(axis=1)  # beta = int J F^-T G dV
+        return np.ascontiguousarray(e), np.ascontiguousarray(x), volumetric_terms
 
     def _pair_coefficients(self, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
         """[C, C'] (P, 2 q 16): C[p, (q, k, l)] = D[q, a_p, k] D[q, b_p, l] and C' the same with k, l exchanged."""
@@ -164,12 +168,16 @@ class Solid:
             blocks[:, s] = self._blocks(u_m, s, ia, ib)
         return sum_pair_blocks(self.mesh.elements, self.mesh.order, blocks, node_index, n)
 
-    def tangent_product(self, u_m: np.ndarray, v_m: np.ndarray) -> np.ndarray:
-        """(N, 3) tangent stiffness at u times the nodal vector v (N), from the elements v touches."""
+    def tangent_product(self, u_m: np.ndarray, v_m: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
+        """(N, 3) tangent stiffness at u times the nodal vector v (N), from the elements v touches; with
+        `rows` (node ids) only those rows are wanted and only the elements touching them are used."""
         f = np.zeros((len(self.mesh.nodes_m), 3))
         nen = self.mesh.elements.shape[1]
         ia, ib = (x.ravel() for x in np.meshgrid(np.arange(nen), np.arange(nen), indexing="ij"))
-        touched = np.flatnonzero(np.any(v_m[self.mesh.elements] != 0, axis=(1, 2)))
+        used = np.any(v_m[self.mesh.elements] != 0, axis=(1, 2))
+        if rows is not None:
+            used &= np.isin(self.mesh.elements, rows).any(axis=1)
+        touched = np.flatnonzero(used)
         for start in range(0, len(touched), _CHUNK):
             el = touched[start : start + _CHUNK]
             k = self._blocks(u_m, el, ia, ib).reshape(nen, nen, len(el), 3, 3)

@@ -98,7 +98,7 @@ def stress(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = No
     kin = _Kinematics.of(F)
     i1b, i2b, d1, d2 = _first(kin)
     w1, w2, *_ = _isochoric(law, i1b, i2b)
-    wj = volumetric(law, kin.J)[1] if pressure_Pa is None else pressure_Pa
+    wj = _volumetric_slopes(law, kin.J, pressure_Pa)[0]
     e = (..., None, None)
     return w1[e] * d1 + w2[e] * d2 + (wj * kin.J)[e] * kin.H
 

@@ -94,6 +94,11 @@ class Pardiso:
             raise SolverError(f"PARDISO failed in phase {phase}: {_ERRORS.get(err.value, f'error {err.value}')}")
         return x
 
+    @property
+    def alive(self) -> bool:
+        """Whether the factorization is held (not yet closed, or closed by an error)."""
+        return self._alive
+
     def _indefinite(self) -> bool:
         """Whether the matrix has a negative eigenvalue (an LDL^T factorization of the same values)."""
         indptr, indices = self._ia, self._ja

@@ -81,14 +81,6 @@ class TorquePath:
     cut_backs: int = 0
     time_s: float = 0.0
 
-    @property
-    def rotation_rad(self) -> np.ndarray:
-        return np.array([p.rotation_rad for p in self.points])
-
-    @property
-    def torque_Nm(self) -> np.ndarray:
-        return np.array([p.torque_Nm for p in self.points])
-
     def rotation_at(self, torque_Nm: float) -> float | None:
         """Rotation (rad) at which the path first carries `torque_Nm` (cubic Hermite between the bracketing
         points, with their tangents), None if it never does."""
@@ -112,7 +104,7 @@ class _Problem:
     settings: PathSettings
     dof_free: np.ndarray  # (n_free, 3) 1.0 for a free degree of freedom of a free node, 0.0 for one held at zero
     pardiso: Pardiso | None = None
-    factored_at: np.ndarray | None = None  # the state of the current factorization within this increment
+    factored_this_step: bool = False  # the factorization is of a Newton iterate of the current increment
 
     def residual(self, f: np.ndarray) -> np.ndarray:
         """The out-of-balance forces (N) on the free degrees of freedom, flattened."""
@@ -131,9 +123,11 @@ class _Problem:
 
     def torque(self, u: np.ndarray, f: np.ndarray) -> float:
         """Reaction torque about z (Nm) that holds the hub: sum of x' x f over the hub nodes."""
-        xd = self.solid.mesh.nodes_m[self.hub] + u[self.hub]
-        fh = f[self.hub]
-        return float(np.sum(xd[:, 0] * fh[:, 1] - xd[:, 1] * fh[:, 0]))
+        return _moment_z(self.solid.mesh.nodes_m[self.hub] + u[self.hub], f[self.hub])
+
+    def converged(self, f: np.ndarray, residual_norm: float) -> bool:
+        """Whether the out-of-balance force is within the tolerance of the hub's reaction forces."""
+        return residual_norm <= self.settings.force_rtol * max(float(np.linalg.norm(f[self.hub])), 1e-12)
 
     def factor(self, u: np.ndarray) -> Pardiso:
         """LDL^T factorization of the free-node tangent at u; NotPositiveDefinite when its inertia counts a
@@ -142,11 +136,11 @@ class _Problem:
         k = self.solid.tangent(u, self.node_index, len(self.free))
         self._hold(k)
         k = k.matrix()
-        if self.pardiso is not None and self.pardiso._alive:
+        if self.pardiso is not None and self.pardiso.alive:
             self.pardiso.refactor(k)
         else:
             self.pardiso = Pardiso(k, indefinite=True)
-        self.factored_at = u
+        self.factored_this_step = True
         if self.pardiso.inertia()[1] > 0:
             raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
         return self.pardiso
@@ -162,6 +156,11 @@ class _Problem:
     def close(self) -> None:
         if self.pardiso is not None:
             self.pardiso.close()
+
+
+def _moment_z(x: np.ndarray, f: np.ndarray) -> float:
+    """z component of sum x x f (Nm) over rows of positions x (m) and forces f (N)."""
+    return float(np.sum(x[:, 0] * f[:, 1] - x[:, 1] * f[:, 0]))
 
 
 def _hermite(a: PathPoint, b: PathPoint, s: np.ndarray | float) -> np.ndarray | float:
@@ -212,28 +211,27 @@ def _min_gap_mm(p: _Problem, u: np.ndarray) -> float:
     return float(_gap(x, n, pairs).min() / MM) if len(pairs) else float("inf")
 
 
-def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, list[float], str]:
-    """Equilibrium of the free nodes at hub rotation theta from the guess u0: (u, residual norms, status)
-    with status "converged", "unstable" (a tangent that is not positive definite) or "failed"."""
-    s = p.settings
+def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, np.ndarray | None, list[float], str]:
+    """Equilibrium of the free nodes at hub rotation theta from the guess u0: (u, its internal forces,
+    residual norms, status) with status "converged", "unstable" (a tangent that is not positive
+    definite) or "failed"."""
     u = u0.copy()
     u[p.hub] = p.hub_displacement(theta)
     norms: list[float] = []
     try:
         f = p.solid.forces(u)
     except FloatingPointError:
-        return u, norms, "failed"
-    p.factored_at = None
-    for _ in range(s.max_iterations):
+        return u, None, norms, "failed"
+    p.factored_this_step = False
+    for _ in range(p.settings.max_iterations):
         r = p.residual(f)
-        scale = max(np.linalg.norm(f[p.hub]), 1e-12)
         norms.append(float(np.linalg.norm(r)))
-        if norms[-1] <= s.force_rtol * scale:
-            return u, norms, "converged"
+        if p.converged(f, norms[-1]):
+            return u, f, norms, "converged"
         try:
             du = -p.factor(u).solve(r).reshape(-1, 3)
         except NotPositiveDefinite:
-            return u, norms, "unstable"
+            return u, f, norms, "unstable"
         e0, slope = None, float(r @ du.ravel())
         alpha = 1.0
         while alpha > 1e-3:
@@ -251,25 +249,26 @@ def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, list
                 pass
             alpha *= 0.5
         else:
-            return u, norms, "failed"
+            return u, f, norms, "failed"
         u, f = trial, f1
     norms.append(float(np.linalg.norm(p.residual(f))))
-    return u, norms, "converged" if norms[-1] <= s.force_rtol * max(np.linalg.norm(f[p.hub]), 1e-12) else "failed"
+    return u, f, norms, "converged" if p.converged(f, norms[-1]) else "failed"
 
 
-def _state(p: _Problem, u: np.ndarray, theta: float, iterations: int, norms: list[float]) -> tuple[PathPoint, np.ndarray]:
-    """The converged point at u and the path's direction du/dtheta there (NotPositiveDefinite: unstable).
-    The tangent is the last Newton iteration's (within the residual tolerance of u), else factored at u."""
-    fac = p.pardiso if p.factored_at is not None else p.factor(u)
+def _state(p: _Problem, u: np.ndarray, f: np.ndarray, theta: float, iterations: int,
+           norms: list[float]) -> tuple[PathPoint, np.ndarray]:
+    """The converged point at u (internal forces f) and the path's direction du/dtheta there
+    (NotPositiveDefinite: unstable). The tangent is the last Newton iteration's (within the residual
+    tolerance of u), else factored at u."""
+    fac = p.pardiso if p.factored_this_step else p.factor(u)
     v = np.zeros_like(u)
     v[p.hub] = p.hub_velocity(theta)
     v[p.free] = -fac.solve(p.residual(p.solid.tangent_product(u, v))).reshape(-1, 3)
-    f = p.solid.forces(u)
-    df = p.solid.tangent_product(u, v)
+    df = p.solid.tangent_product(u, v, rows=p.hub)  # dT/dtheta needs the hub's rows only
     xd = p.solid.mesh.nodes_m[p.hub] + u[p.hub]
-    dT = float(np.sum(v[p.hub, 0] * f[p.hub, 1] - v[p.hub, 1] * f[p.hub, 0])
-               + np.sum(xd[:, 0] * df[p.hub, 1] - xd[:, 1] * df[p.hub, 0]))
-    point = PathPoint(theta, p.torque(u, f), dT, p.solid.peak_principal_strain(u), _min_gap_mm(p, u), iterations, tuple(norms))
+    dT = _moment_z(v[p.hub], f[p.hub]) + _moment_z(xd, df[p.hub])
+    point = PathPoint(theta, p.torque(u, f), dT, p.solid.peak_principal_strain(u), _min_gap_mm(p, u), iterations,
+                      tuple(norms))
     return point, v
 
 
@@ -338,17 +337,17 @@ def rotation_path(
     p = _problem(mesh, law, settings, order, hub_boundaries, ring_boundaries, axially_held_faces, formulation)
     u = np.zeros_like(p.solid.mesh.nodes_m)
     try:
-        first, v = _state(p, u, 0.0, 0, [0.0])
+        first, v = _state(p, u, np.zeros_like(u), 0.0, 0, [0.0])
         points, step, cuts, reason, previous = [first], settings.first_step_rad, 0, None, None
         while reason is None:
             last = points[-1]
             step = min(step, settings.max_step_rad, settings.max_rotation_rad - last.rotation_rad)
             theta = last.rotation_rad + step
-            trial, norms, status = _newton(p, _predict(p, u, v, step, previous, last.rotation_rad), theta)
+            trial, forces, norms, status = _newton(p, _predict(p, u, v, step, previous, last.rotation_rad), theta)
             event = None
             if status == "converged":
                 try:
-                    point, v_new = _state(p, trial, theta, len(norms) - 1, norms)
+                    point, v_new = _state(p, trial, forces, theta, len(norms) - 1, norms)
                     event = _stop_check(p, last, point, target_torque_Nm)
                 except NotPositiveDefinite:
                     status = "unstable"
