@@ -42,7 +42,6 @@ from seadesign.twin.config import KneeConfig, knee_effects
 from seadesign.twin.walk import Gait, Trial, knee_targets
 
 SIGN = np.array([KNEE_SIGN["l"], KNEE_SIGN["r"]])  # knee axis: 0 left, 1 right
-FIELDS = KNEE_FIELDS  # the per-knee fields of the robot format, logged in its order
 
 
 @dataclass
@@ -67,7 +66,7 @@ class Observation:
         """One trial's values under the robot format's column names (plus `l_target`, `r_target`)."""
         out = {"time_s": self.time_s}
         for k, side in enumerate("lr"):
-            for field in FIELDS:
+            for field in KNEE_FIELDS:
                 out[f"{side}_{field}"] = float(getattr(self, field)[trial, k])
             out[f"{side}_target"] = float(self.target[trial, k])
         return out
@@ -104,7 +103,7 @@ class KneeSession:
         self.dt = 1.0 / self.rate_hz
         self.n_sub = max(1, math.ceil(self.dt / self.config.max_substep_s - 1e-9))
         self._k = 0
-        self._log = {f: np.empty((self.n_trials, self.n_steps, 2)) for f in FIELDS + ("command",)}
+        self._log = {f: np.empty((self.n_trials, self.n_steps, 2)) for f in KNEE_FIELDS + ("command",)}
         self._init_physics(flex_target[:, 0, :])
         self._obs = self._sense()
 
@@ -126,7 +125,7 @@ class KneeSession:
         cmd = obs.target if command is None else np.asarray(command, dtype=float)
         if cmd.shape != (self.n_trials, 2) or not np.isfinite(cmd).all():
             raise ConfigError(f"command must be finite with shape ({self.n_trials}, 2) in rad; got {cmd.shape}")
-        for field in FIELDS:
+        for field in KNEE_FIELDS:
             self._log[field][:, self._k] = getattr(obs, field)
         self._log["command"][:, self._k] = cmd
         self._advance(cmd * SIGN, self.stance[:, self._k])
@@ -167,7 +166,7 @@ class KneeSession:
         stamp = self.start_time_s + (np.arange(self.n_trials)[:, None] * duration + self.time[None, :m])
         out: dict[str, Any] = {"time_s": (stamp - stamp[0, 0]).ravel(), "timestamp": stamp.ravel()}
         for k, side in enumerate("lr"):
-            for field in FIELDS:
+            for field in KNEE_FIELDS:
                 out[f"{side}_{field}"] = self._log[field][:, :m, k].ravel()
         out.update({c: v.reshape(self.n_trials, self.n_steps)[:, :m].ravel()
                     for c, v in self._imu_and_pressure().items()})
