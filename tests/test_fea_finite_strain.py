@@ -168,3 +168,20 @@ def test_tangent_at_rest_is_the_linear_stiffness(small):
             assert err < 1e-12
         else:  # a constant pressure per element: softer, as the mixed P2/P0 element is
             assert 1e-3 < err
+
+
+@pytest.mark.parametrize("formulation", ["full", "mean_dilatation"])
+def test_element_strain_and_cauchy_von_mises_of_a_homogeneous_deformation(small, formulation):
+    """u = (F - I) X: every quadrature point has this F, so the peak stretch is F's largest singular value
+    and the Cauchy stress the closed-form neo-Hookean sigma = 2 C10 J^(-5/3) dev(F F^T) + 2 (J - 1) / D1 I
+    (whose von Mises is that of its deviatoric part)."""
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    F = np.array([[1.3, 0.4, 0.0], [0.1, 0.9, 0.05], [0.0, -0.2, 1.1]])
+    u = emesh.nodes_m @ (F - np.eye(3)).T
+    stretch, mises = Solid.of(emesh, NEO, formulation).element_strain_stress(u)
+    b = F @ F.T
+    dev = 2 * NEO.c10_Pa * np.linalg.det(F) ** (-5 / 3) * (b - np.trace(b) / 3 * np.eye(3))
+    # measured: 4e-16 and 2e-15 relative (round-off)
+    assert np.allclose(stretch, np.linalg.svd(F, compute_uv=False)[0], rtol=1e-13, atol=0)
+    assert np.allclose(mises, np.sqrt(1.5 * np.sum(dev * dev)), rtol=1e-12, atol=0)

@@ -184,13 +184,21 @@ class Solid:
             _scatter(f, self.mesh.elements[el], np.einsum("abmik,mbk->mai", k, v_m[self.mesh.elements[el]]))
         return f
 
-    def peak_principal_strain(self, u_m: np.ndarray) -> float:
-        """Largest principal engineering strain (max stretch - 1) over the quadrature points."""
-        peak = 0.0
-        for s in _chunks(len(self.mesh.elements)):
+    def element_strain_stress(self, u_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per element, the largest over its quadrature points of the principal stretch (max eigenvalue
+        of U = sqrt(F^T F), so engineering strain = stretch - 1, logarithmic = ln stretch) and of the Cauchy
+        von Mises stress (Pa) of sigma = P F^T / J; both (m,)."""
+        m = len(self.mesh.elements)
+        stretch, mises = np.empty(m), np.empty(m)
+        for s in _chunks(m):
             F = self.deformation_gradient(u_m, s)
-            peak = max(peak, float(np.sqrt(np.linalg.eigvalsh(np.swapaxes(F, -1, -2) @ F)[..., -1].max())) - 1.0)
-        return peak
+            stretch[s] = np.sqrt(np.linalg.eigvalsh(np.swapaxes(F, -1, -2) @ F)[..., -1].max(axis=1))
+            md = self._mean_dilatation(F, self.weights_m3[s])
+            sig = stress(self.law, F, None if md is None else md[0]) @ np.swapaxes(F, -1, -2)
+            sig /= det_and_inverse_transpose(F)[0][..., None, None]
+            dev = sig - np.trace(sig, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) / 3
+            mises[s] = np.sqrt(1.5 * np.einsum("...ij,...ij->...", dev, dev)).max(axis=1)
+        return stretch, mises
 
 
 def _chunks(m: int) -> list[slice]:

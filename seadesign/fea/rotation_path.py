@@ -66,6 +66,9 @@ class PathPoint:
     min_gap_mm: float  # smallest gap between facing surfaces (mm; inf: none within the search distance)
     iterations: int
     residual_norms_N: tuple[float, ...]
+    peak_strain_element: int = -1  # element of the peak strain
+    peak_von_mises_Pa: float = 0.0  # largest Cauchy von Mises stress at the quadrature points
+    peak_von_mises_element: int = -1
 
 
 @dataclass(frozen=True)
@@ -267,8 +270,10 @@ def _state(p: _Problem, u: np.ndarray, f: np.ndarray, theta: float, iterations: 
     df = p.solid.tangent_product(u, v, rows=p.hub)  # dT/dtheta needs the hub's rows only
     xd = p.solid.mesh.nodes_m[p.hub] + u[p.hub]
     dT = _moment_z(v[p.hub], f[p.hub]) + _moment_z(xd, df[p.hub])
-    point = PathPoint(theta, p.torque(u, f), dT, p.solid.peak_principal_strain(u), _min_gap_mm(p, u), iterations,
-                      tuple(norms))
+    stretch, mises = p.solid.element_strain_stress(u)
+    i, j = int(np.argmax(stretch)), int(np.argmax(mises))
+    point = PathPoint(theta, p.torque(u, f), dT, float(stretch[i]) - 1.0, _min_gap_mm(p, u), iterations, tuple(norms),
+                      i, float(mises[j]), j)
     return point, v
 
 
