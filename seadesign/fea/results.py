@@ -143,14 +143,19 @@ def scaled(result: Any, factor: float) -> Any:
     return replace(result, **changes)
 
 
-def columns(result: Any, prefix: str = "") -> dict[str, float]:
-    """Flat {column: value} of a results dataclass, nested names joined by "_"."""
-    out: dict[str, float] = {}
+def columns(result: Any, prefix: str = "") -> dict[str, Any]:
+    """Flat {column: value} of a results dataclass, nested names joined by "_": numbers as floats, flags and
+    words as they are, a tuple of numbers as a list."""
+    out: dict[str, Any] = {}
     for f in dataclasses.fields(result):
         value = getattr(result, f.name)
         if dataclasses.is_dataclass(value):
             inner = f.metadata.get("prefix")
             out.update(columns(value, prefix + (f"{f.name}_" if inner is None else inner)))
+        elif isinstance(value, (str, bool)):
+            out[prefix + f.name] = value
+        elif isinstance(value, tuple):  # a curve's points: a list in the row and the parquet table
+            out[prefix + f.name] = list(value)
         else:
             out[prefix + f.name] = float(value)
     return out
