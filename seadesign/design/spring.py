@@ -142,6 +142,21 @@ class TorqueCurve:
         """Initial stiffness dT/dtheta at 0 (Nm/rad)."""
         return float(self._pchip().derivative()(0.0))
 
+    def torque_at_energy(self, energy_J: float) -> float | None:
+        """The torque (Nm) where the curve, loaded from rest, has stored `energy_J` (J): int_0^theta T dtheta
+        = energy; None when the whole curve stores less (a load that reaches its end)."""
+        stored = self._pchip().antiderivative()
+        theta = np.asarray(self.rotation_rad)
+        total = stored(theta)
+        if total[-1] < energy_J:
+            return None
+        i = max(int(np.searchsorted(total, energy_J)), 1)
+        lo, hi = theta[i - 1], theta[i]
+        for _ in range(60):  # bisection on the increasing stored energy
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if stored(mid) < energy_J else (lo, mid)
+        return float(self._pchip()(0.5 * (lo + hi)))
+
     def torque(self, rotation_rad: np.ndarray) -> np.ndarray:
         """T(theta) (Nm), odd in theta; past the end: the end torque with a hard stop, else CurveRangeError."""
         th = np.asarray(rotation_rad, dtype=float)

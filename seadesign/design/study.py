@@ -104,11 +104,11 @@ class Ranking:
     max_standing_deflection_deg: float  # knee deflection under the standing load
     k_min_Nm_per_rad: float | None
     k_max_Nm_per_rad: float | None
-    small_deflection_limit_rad: float  # beyond it a linear solution is an extrapolation
     impact_speed_m_per_s: float  # foot speed at touchdown
     knee_inertia_kg_m2: float  # inertia of the link behind the spring, about the knee
     weight_accuracy: float
     weight_protection: float
+    contact_is_end_stop: bool = False  # contact closing a gap may carry torque past it (else: contact ends the travel)
 
 
 @dataclass(frozen=True)
@@ -259,16 +259,19 @@ def _mesh(top: Table) -> MeshSettings:
 
 def _ranking(top: Table) -> Ranking:
     rk = top.table("ranking")
+    if rk.raw("small_deflection_limit_rad") is not None:
+        raise rk.error(rk.key("small_deflection_limit_rad"), "is no longer used: the large-deflection path replaced the "
+                       "small-deflection flag; remove the line")
     ranking = Ranking(
         safety_factor=rk.number("safety_factor", ge=1),
         max_standing_deflection_deg=rk.number("max_standing_deflection_deg", gt=0),
         k_min_Nm_per_rad=rk.number("k_min_Nm_per_rad", gt=0, required=False),
         k_max_Nm_per_rad=rk.number("k_max_Nm_per_rad", gt=0, required=False),
-        small_deflection_limit_rad=rk.number("small_deflection_limit_rad", gt=0),
         impact_speed_m_per_s=rk.number("impact_speed_m_per_s", gt=0),
         knee_inertia_kg_m2=rk.number("knee_inertia_kg_m2", gt=0),
         weight_accuracy=rk.number("weight_accuracy", ge=0),
         weight_protection=rk.number("weight_protection", ge=0),
+        contact_is_end_stop=rk.boolean("contact_is_end_stop", False),
     )
     rk.done()
     if ranking.weight_accuracy + ranking.weight_protection <= 0:

@@ -40,7 +40,8 @@ class LoadPoint:
 
 @dataclass(frozen=True)
 class PeakLocation:
-    """Where a peak sits in the part frame (mm): the centroid of its element."""
+    """Where a peak or a contact sits in the part frame (mm): the centroid of the peak's element, the
+    midpoint of the closing pair."""
 
     x_mm: float = unscaled()
     y_mm: float = unscaled()
@@ -58,6 +59,7 @@ class LargeDeflection:
     stop_torque_Nm: float = unscaled()
     contact_rotation_rad: float = unscaled()  # NaN: no contact on the path
     contact_torque_Nm: float = unscaled()
+    contact_at: PeakLocation = nested()  # the closing pair's midpoint at rest (NaN: no contact)
     allowable_strain: float = unscaled()  # NaN: the material has no sourced elongation at yield
     strain_limit_rotation_rad: float = unscaled()  # where the peak strain passes the allowable (NaN: never)
     strain_limit_torque_Nm: float = unscaled()
@@ -138,6 +140,7 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
         stop_torque_Nm=path.stop_torque_Nm,
         contact_rotation_rad=path.stop_rotation_rad if contact else math.nan,
         contact_torque_Nm=path.stop_torque_Nm if contact else math.nan,
+        contact_at=PeakLocation(*pts[-1].min_gap_at_mm) if contact else PeakLocation(math.nan, math.nan, math.nan),
         allowable_strain=allowable,
         strain_limit_rotation_rad=limit_theta,
         strain_limit_torque_Nm=float(np.interp(limit_theta, theta, torque)) if math.isfinite(limit_theta) else math.nan,

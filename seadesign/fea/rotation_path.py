@@ -12,7 +12,8 @@ The path stops, and says why (`STOP_REASONS` of `design.spring`):
 - limit_point: T passed a maximum below the target (dT/dtheta <= 0) while the free nodes' tangent
   stays positive definite: the torque-driven spring snaps through there; the stop is the maximum;
 - bifurcation: the free nodes' tangent stiffness lost positive definiteness (an eigenvalue crossed
-  zero, counted by its inertia: a buckling mode); both are located by bisection to `locate_tol_rad`;
+  zero, counted by its inertia: a buckling mode); both are located by bisection to `locate_tol_rad`
+  (contact to `contact_locate_tol_rad`, then where the gap interpolates to the tolerance);
 - contact: two facing surfaces (outward normals opposed by more than 120 degrees) come closer
   than `contact_gap_mm` (the notch beside a beam's root closing, a beam reaching its neighbour);
   the model has no contact forces, so the path ends there, interpolated to the tolerance;
@@ -49,7 +50,8 @@ class PathSettings:
     max_rotation_rad: float = 6.0
     max_iterations: int = 12
     force_rtol: float = 1e-7  # residual norm over the norm of the reaction forces
-    locate_tol_rad: float = 1e-3  # bisection tolerance of a bifurcation's rotation
+    locate_tol_rad: float = 1e-3  # bisection tolerance of a limit point's, bifurcation's or strain limit's rotation
+    contact_locate_tol_rad: float = 1e-2  # bisection tolerance of contact (then interpolated in the gap)
     contact_gap_mm: float = 0.1  # a quarter of an extrusion width: printed faces are not truer than that
     contact_search_mm: float = 0.5  # below the thinnest feature: faces further apart are never checked
     allowable_strain: float | None = None  # engineering strain; None: no strain stop
@@ -69,6 +71,7 @@ class PathPoint:
     peak_strain_element: int = -1  # element of the peak strain
     peak_von_mises_Pa: float = 0.0  # largest Cauchy von Mises stress at the quadrature points
     peak_von_mises_element: int = -1
+    min_gap_at_mm: tuple[float, float, float] = (float("nan"),) * 3  # where the smallest gap is (at rest)
 
 
 @dataclass(frozen=True)
@@ -83,6 +86,8 @@ class TorquePath:
     emesh: ElementMesh = field(repr=False)
     cut_backs: int = 0
     time_s: float = 0.0
+    snapshot_index: int = -1  # the point whose displacement is `snapshot_displacement_m` (see rotation_path)
+    snapshot_displacement_m: np.ndarray | None = field(default=None, repr=False)
 
     def rotation_at(self, torque_Nm: float) -> float | None:
         """Rotation (rad) at which the path first carries `torque_Nm` (cubic Hermite between the bracketing
@@ -198,11 +203,11 @@ def _gap(x: np.ndarray, n: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     return 0.5 * np.einsum("ij,ij->i", d, n[pairs[:, 0]] - n[pairs[:, 1]])
 
 
-def _min_gap_mm(p: _Problem, u: np.ndarray) -> float:
-    """Smallest gap (mm) between facing boundary vertices of the deformed part: pairs within the search
-    distance whose outward normals are opposed (cosine < -0.5) and that faced each other across open
-    space at rest (not the two sides of a thin wall); the gap is their separation along the normals,
-    negative once they overlap."""
+def _min_gap_mm(p: _Problem, u: np.ndarray) -> tuple[float, tuple[float, float, float]]:
+    """Smallest gap (mm) between facing boundary vertices of the deformed part, and where (the pair's
+    midpoint at rest, mm; NaN without a pair): pairs within the search distance whose outward normals
+    are opposed (cosine < -0.5) and that faced each other across open space at rest (not the two sides
+    of a thin wall); the gap is their separation along the normals, negative once they overlap."""
     x0 = p.solid.mesh.nodes_m[p.surface]
     x = x0 + u[p.surface]
     n = _vertex_normals(p.solid.mesh.nodes_m + u, p.boundary_faces, p.surface)
@@ -211,7 +216,11 @@ def _min_gap_mm(p: _Problem, u: np.ndarray) -> float:
         pairs = pairs[np.einsum("ij,ij->i", n[pairs[:, 0]], n[pairs[:, 1]]) < -0.5]
     if len(pairs):
         pairs = pairs[_gap(x0, p.rest_normals, pairs) > 0]
-    return float(_gap(x, n, pairs).min() / MM) if len(pairs) else float("inf")
+    if not len(pairs):
+        return float("inf"), (float("nan"),) * 3
+    gaps = _gap(x, n, pairs)
+    k = int(np.argmin(gaps))
+    return float(gaps[k] / MM), tuple(float(c) for c in x0[pairs[k]].mean(axis=0) / MM)
 
 
 def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, np.ndarray | None, list[float], str]:
@@ -272,8 +281,9 @@ def _state(p: _Problem, u: np.ndarray, f: np.ndarray, theta: float, iterations: 
     dT = _moment_z(v[p.hub], f[p.hub]) + _moment_z(xd, df[p.hub])
     stretch, mises = p.solid.element_strain_stress(u)
     i, j = int(np.argmax(stretch)), int(np.argmax(mises))
-    point = PathPoint(theta, p.torque(u, f), dT, float(stretch[i]) - 1.0, _min_gap_mm(p, u), iterations, tuple(norms),
-                      i, float(mises[j]), j)
+    gap, gap_at = _min_gap_mm(p, u)
+    point = PathPoint(theta, p.torque(u, f), dT, float(stretch[i]) - 1.0, gap, iterations, tuple(norms),
+                      i, float(mises[j]), j, gap_at)
     return point, v
 
 
@@ -331,11 +341,13 @@ def rotation_path(
     ring_boundaries: list[str] | None = None,
     axially_held_faces: np.ndarray | None = None,
     formulation: str = "full",
+    snapshot_torque_Nm: float | None = None,
 ) -> TorquePath:
     """Follow T(theta) from rest until the hub torque reaches `target_torque_Nm` (Nm) or the path stops
     (see the module doc); the points are the converged increments. `axially_held_faces`: boundary
     facets (k, 3) of the mesh whose nodes keep u_z = 0 (an analytical test's plane constraint);
-    `formulation`: see `fea.finite_strain`."""
+    `formulation`: see `fea.finite_strain`; `snapshot_torque_Nm`: also keep the displacement of the
+    first point that carries this torque (Nm), or of the last point if none does (a render's state)."""
     if not target_torque_Nm > 0:
         raise SolverError(f"target_torque_Nm must be positive, got {target_torque_Nm:g}")
     t0 = time.perf_counter()
@@ -344,6 +356,7 @@ def rotation_path(
     try:
         first, v = _state(p, u, np.zeros_like(u), 0.0, 0, [0.0])
         points, step, cuts, reason, previous = [first], settings.first_step_rad, 0, None, None
+        snapshot = None
         while reason is None:
             last = points[-1]
             step = min(step, settings.max_step_rad, settings.max_rotation_rad - last.rotation_rad)
@@ -356,7 +369,7 @@ def rotation_path(
                     event = _stop_check(p, last, point, target_torque_Nm)
                 except NotPositiveDefinite:
                     status = "unstable"
-            located = step <= settings.locate_tol_rad
+            located = step <= (settings.contact_locate_tol_rad if event == "contact" else settings.locate_tol_rad)
             if status == "unstable" and located:
                 reason = "bifurcation"
             elif status != "converged" or (event not in (None, "target_reached") and not located):
@@ -367,6 +380,8 @@ def rotation_path(
                     reason = "unconverged"
             else:
                 points.append(point)
+                if snapshot is None and snapshot_torque_Nm is not None and point.torque_Nm >= snapshot_torque_Nm:
+                    snapshot = (len(points) - 1, trial)
                 previous = (u, last.rotation_rad)
                 u, v, reason = trial, v_new, event
                 if len(norms) <= 5:
@@ -374,7 +389,9 @@ def rotation_path(
     finally:
         p.close()
     stop_theta, stop_torque = _stop_point(points, reason, target_torque_Nm, settings.contact_gap_mm)
-    return TorquePath(tuple(points), reason, stop_theta, stop_torque, u, p.solid.mesh, cuts, time.perf_counter() - t0)
+    index, shot = snapshot or (len(points) - 1, u)
+    return TorquePath(tuple(points), reason, stop_theta, stop_torque, u, p.solid.mesh, cuts, time.perf_counter() - t0,
+                      index, shot)
 
 
 def _predict(p: _Problem, u: np.ndarray, v: np.ndarray, step: float,

@@ -17,7 +17,8 @@ from seadesign.design.spring import write_spring
 from seadesign.sweep.rank import Choice
 from seadesign.report.document import write_html, write_markdown
 from seadesign.sweep.handoff import spring_document
-from seadesign.sweep.stages import SolverSettings, fea_key, geometry_key
+from seadesign.sweep.path_stage import path_key
+from seadesign.sweep.stages import SolverSettings, geometry_key
 from seadesign.design.space import axis_label
 from seadesign.design.study import Study
 
@@ -70,7 +71,7 @@ def export_cad(study: Study, rows: pd.DataFrame, folder: Path, tolerance_mm: flo
 
 def write_plots(study: Study, t: pd.DataFrame, choice: Choice, folder: Path) -> dict[str, Path]:
     """The sweep's figures by caption, over the study's design axes; unchanged results keep their PNGs."""
-    from seadesign.report.plots import fig_k, fig_pareto, fig_reaction_displacement
+    from seadesign.report.plots import fig_curves, fig_k, fig_pareto, fig_reaction_displacement
 
     axes = [a.key for a in study.axes]
     thesis = axes[:2] == ["beam_count", "beam_thickness_mm"]
@@ -79,6 +80,9 @@ def write_plots(study: Study, t: pd.DataFrame, choice: Choice, folder: Path) -> 
             (lambda table, path: fig_reaction_displacement(table, axes, path), folder / "reaction_displacement.png"),
         f"k vs {axis_label(axes[0])}": (lambda table, path: fig_k(table, axes, path), folder / f"k_vs_{axes[0]}.png"),
         "Pareto front": (lambda table, path: fig_pareto(table, choice.index, path), folder / "pareto.png"),
+        "Large-deflection torque curves": (
+            lambda table, path: fig_curves(table, choice.index, study.load_cases.stall_torque_Nm,
+                                           study.load_cases.impact_torque_Nm, path), folder / "torque_curves.png"),
     }
     numbers = t.drop(columns=["elapsed_s", "traceback"], errors="ignore")
     key = digest("plots", numbers[sorted(numbers.columns)].to_json(), choice.index, axes,
@@ -93,24 +97,22 @@ def write_plots(study: Study, t: pd.DataFrame, choice: Choice, folder: Path) -> 
 
 def write_renders(study: Study, row: pd.Series, folder: Path, solver: SolverSettings,
                   cache: Cache) -> dict[str, Path]:
-    """Renders of the chosen candidate under both load cases, by caption (none when its FEA is not
-    cached or off-screen rendering is unavailable); unchanged inputs keep their PNGs."""
-    from seadesign.report.renders import render_case
+    """The chosen candidate's large-deflection state at the stall torque (or where its path stops), by caption
+    (none when its path is not cached or off-screen rendering is unavailable); unchanged inputs keep the PNG."""
+    from seadesign.report.renders import render_path
 
-    key_fea = fea_key(study, study.candidate_of_row(row), solver)
-    out = {}
-    for case in ("stall", "impact"):
-        torque = float(row[f"{case}_torque_Nm"])
-        title = f"{row['candidate']}: {case}, {torque:.3g} Nm"
-        path = folder / f"chosen_{case}.png"
-        key = digest("render", key_fea, torque, title, code_fingerprint("seadesign.report.renders"))
-        if not up_to_date([path], key):
-            unit = cache.get("fea", key_fea)
-            if unit is None or render_case(unit, case, torque, title, path) is None:
-                continue
-            stamp([path], key)
-        out[f"Chosen part under the {case} load case (colour: von Mises, MPa)"] = path
-    return out
+    key_path = path_key(study, study.candidate_of_row(row), solver)
+    reached = bool(row["large_stall_reached"])
+    where = "at the stall torque" if reached else f"where its path stops ({row['large_stop_reason']})"
+    title = f"{row['candidate']}: large deflection {where}"
+    path = folder / "chosen_large_deflection.png"
+    key = digest("render", key_path, title, code_fingerprint("seadesign.report.renders"))
+    if not up_to_date([path], key):
+        response = cache.get("path", key_path)
+        if response is None or render_path(response, float(row["large_allowable_strain"]), title, path) is None:
+            return {}
+        stamp([path], key)
+    return {f"Chosen part {where}, true scale (colour: largest principal strain, %)": path}
 
 
 def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, settings: dict, *,

@@ -10,11 +10,12 @@ from pathlib import Path
 import pandas as pd
 
 SUMMARY_COLUMNS = [
-    "candidate", "status", "mass_g", "k_Nm_per_rad", "k_rel_error", "stall_bearing_displacement_mm",
-    "stall_foot_error_mm", "impact_reaction_per_bolt_N", "thesis_reaction_N", "thesis_displacement_mm",
-    "stall_von_mises_max_MPa", "impact_von_mises_max_MPa", "standing_deflection_deg", "impact_energy_J",
-    "impact_gearbox_torque_Nm", "max_rotation_rad", "extrapolation", "feasible", "pareto", "score", "rank",
-    "failed_constraints", "reason",
+    "candidate", "status", "mass_g", "k_Nm_per_rad", "k_rel_error", "large_stop_reason", "large_stop_rotation_rad",
+    "large_stop_torque_Nm", "large_strain_limit_torque_Nm", "large_stall_rotation_rad", "large_stall_secant_k_Nm_per_rad",
+    "large_stall_tangent_k_Nm_per_rad", "large_stall_bearing_displacement_mm", "large_stall_peak_strain",
+    "large_stall_strain_margin", "large_stall_survives", "large_impact_survives", "standing_deflection_deg",
+    "impact_gearbox_torque_Nm", "stall_rotation_rad", "stall_von_mises_max_MPa", "thesis_reaction_N",
+    "thesis_displacement_mm", "feasible", "pareto", "score", "rank", "failed_constraints", "reason",
 ]
 
 
@@ -41,15 +42,37 @@ def sections(study, t: pd.DataFrame, explanation: str, settings: dict) -> list[t
         ("Choice", explanation),
         ("Constraints that removed candidates",
          "; ".join(f"{c}: {n} candidates" for c, n in counts.items()) or "none"),
-        ("Objectives", "accuracy = stall bearing displacement (mm); protection = peak torque a foot strike drives "
-                       f"into the gearbox, w sqrt(k J) with w = {rk.impact_speed_m_per_s:g} m/s / lower leg and "
-                       f"J = {rk.knee_inertia_kg_m2:g} kg m^2; weights {rk.weight_accuracy:g} / {rk.weight_protection:g}. "
-                       "For a linear spring both depend on k alone, so the Pareto front holds every pool candidate "
-                       "with a distinct k and the weighted score picks the point on it."),
-        ("Model range", f"Rotations above {rk.small_deflection_limit_rad:g} rad are flagged as extrapolation of the "
-                        f"linear model ({int(t['extrapolation'].sum())} of {len(t)} candidates)."),
+        ("Objectives", "accuracy = the arc the bearing circle turns through at the stall torque, read from the "
+                       "large-deflection curve (mm); protection = peak torque a foot strike drives into the gearbox: "
+                       "the torque where the curve has stored the leg's kinetic energy J w^2 / 2, with "
+                       f"w = {rk.impact_speed_m_per_s:g} m/s / lower leg and J = {rk.knee_inertia_kg_m2:g} kg m^2; "
+                       f"weights {rk.weight_accuracy:g} / {rk.weight_protection:g}."),
+        ("Large deflection", large_deflection_summary(t)),
+        ("Linear model", "The linear results (k at small load, stall rotation torque / k, von Mises stresses) stay in "
+                         "the table for comparison with the thesis; at these loads they are outside their range, so "
+                         "nothing is ranked on them and yield stress against a linear stress is not a criterion."),
         ("Settings and versions", ", ".join(f"{k}: {v}" for k, v in settings.items())),
     ]
+
+
+def large_deflection_summary(t: pd.DataFrame) -> str:
+    """How the solved candidates' torque paths went, in words: where they stop and why, and the strain limit."""
+    solved = t[t["status"] == "ok"]
+    if solved.empty or "large_stop_reason" not in solved:
+        return "No candidate was solved."
+    stops = solved["large_stop_reason"].value_counts()
+    allowable = solved["large_allowable_strain"].dropna()
+    text = ("Each solved candidate's hub is rotated (hyperelastic finite-strain FEA, hub held as the servo holds it) "
+            "until the impact torque or a stop. Stops: " + ", ".join(f"{r}: {n}" for r, n in stops.items()) + ". "
+            f"{int(solved['large_stall_survives'].astype(bool).sum())} of {len(solved)} carry the stall torque within "
+            f"the allowable strain; {int(solved['large_impact_survives'].astype(bool).sum())} the impact torque. Torque "
+            f"carried before the path stops: {solved['large_stop_torque_Nm'].min():.3g}-"
+            f"{solved['large_stop_torque_Nm'].max():.3g} Nm.")
+    if not allowable.empty:
+        passed = solved["large_strain_limit_torque_Nm"].dropna()
+        text += (f" Allowable strain {allowable.iloc[0]:.3g} (elongation at yield / safety factor): passed by "
+                 f"{len(passed)} candidates" + (f", at {passed.min():.3g}-{passed.max():.3g} Nm." if len(passed) else "."))
+    return text
 
 
 def write_markdown(path: Path, study, t: pd.DataFrame, explanation: str, settings: dict, images: dict[str, Path]) -> Path:

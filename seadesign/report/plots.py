@@ -1,5 +1,6 @@
 """Matplotlib figures of a ranked sweep (PNG): reaction and displacement (the thesis's fig. 5.3
-where beam count and beam thickness are the axes), k, and the Pareto front.
+where beam count and beam thickness are the axes), k, the Pareto front, and the large-deflection
+torque curves.
 
 The figures adapt to the study's design axes: the first axis is the x axis, and one series is
 drawn per value of the other axes (per beam thickness in the default study).
@@ -101,10 +102,39 @@ def fig_pareto(t: pd.DataFrame, chosen: int | None, path: Path) -> Path:
     if chosen is not None:
         c = t.loc[chosen]
         ax.plot(c[ACCURACY], c[PROTECTION], "r*", ms=16, label=f"chosen: {c['candidate']}")
-    ax.set(xlabel="stall bearing displacement (mm), lower = more accurate",
-           ylabel="peak impact torque into gearbox (Nm)", xscale="log", title="Accuracy vs gearbox protection")
+    ax.set(xlabel="stall bearing arc (mm, large deflection), lower = more accurate",
+           ylabel="peak strike torque into gearbox (Nm)", xscale="log", title="Accuracy vs gearbox protection")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
+    return _save(fig, path)
+
+
+def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: float, path: Path) -> Path:
+    """Torque-rotation curves of the large-deflection paths: the Pareto candidates (the ranked pool when it
+    could not be scored) in colour, the other solved ones in grey; each curve's stop marked by its reason
+    (x: contact), where the peak strain passes the allowable (o), and the load torques."""
+    fig, ax = plt.subplots(figsize=(7, 4.8))
+    solved = t[t["status"] == "ok"]
+    shown = solved[solved["pareto"].astype(bool)] if solved["pareto"].astype(bool).any() else solved[solved["rank"].notna()]
+    for _, r in solved.drop(index=shown.index).iterrows():
+        ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color="0.8", lw=0.8)
+    markers = {"contact": "x", "limit_point": "^", "bifurcation": "v", "target_reached": "|"}
+    for i, (_, r) in enumerate(shown.iterrows()):
+        color = "r" if chosen is not None and r.name == chosen else f"C{i % 10}"
+        ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color=color, lw=1.6,
+                label=f"{r['candidate']} ({r['large_stop_reason']})")
+        ax.plot(r["large_stop_rotation_rad"], r["large_stop_torque_Nm"], markers.get(r["large_stop_reason"], "s"),
+                color=color, ms=9, mew=2)
+        if np.isfinite(r["large_strain_limit_rotation_rad"]):
+            ax.plot(r["large_strain_limit_rotation_rad"], r["large_strain_limit_torque_Nm"], "o", mfc="none",
+                    color=color, ms=7)
+    for torque, name in ((stall_Nm, "stall"), (impact_Nm, "impact")):
+        ax.axhline(torque, color="k", ls="--", lw=0.8)
+        ax.annotate(f"{name} {torque:.3g} Nm", (0, torque), fontsize=7, xytext=(2, 2), textcoords="offset points")
+    ax.set(xlabel="hub rotation (rad)", ylabel="torque (Nm)",
+           title="Large-deflection torque curves (x: contact, o: allowable strain passed)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=6, ncol=2)
     return _save(fig, path)
 
 

@@ -1,20 +1,16 @@
-"""spring.json for the chosen candidate: k, its error estimate, design, material, load cases."""
+"""spring.json for the chosen candidate: k, its error estimate, design, material, the linear load cases,
+and the large-deflection torque curve with its reading at the loads."""
 
 from __future__ import annotations
 
 import dataclasses
 import math
 
+import numpy as np
 import pandas as pd
 
 from seadesign.design.spring import SCHEMA_VERSION
 from seadesign.design.study import Study
-
-EXTRAPOLATION_NOTE = (
-    "linear FEA; beyond {limit:g} rad the beams' rotations are no longer small (sin x ~ x within 0.2 %), "
-    "so results at larger rotation are an extrapolation of the linear model"
-)
-
 
 def _number(value) -> float | None:
     v = float(value)
@@ -35,7 +31,6 @@ def spring_document(study: Study, row: pd.Series, inputs_hash: str, versions: di
     candidate = study.candidate_of_row(row)
     params = candidate.params
     a, lc, r = study.actuator, study.load_cases, study.robot
-    limit = study.ranking.small_deflection_limit_rad
     return {
         "schema_version": SCHEMA_VERSION,
         "study": study.name,
@@ -52,13 +47,36 @@ def spring_document(study: Study, row: pd.Series, inputs_hash: str, versions: di
         },
         "robot": {"mass_kg": r.mass_kg, "lower_leg_m": r.lower_leg_m, "upper_leg_m": r.upper_leg_m},
         "load_cases": {case: load_case_block(row, case) for case in ("stall", "impact")},
-        "extrapolation": {
-            "flagged": bool(row["extrapolation"]),
-            "threshold_rad": limit,
-            "max_rotation_rad": float(row["max_rotation_rad"]),
-            "note": EXTRAPOLATION_NOTE.format(limit=limit),
-        },
+        "torque_curve": handoff_curve(row, study.ranking.contact_is_end_stop),
+        "large_deflection": large_deflection_block(row),
         "selection": selection,
         "inputs_hash": inputs_hash,
         "versions": versions,
     }
+
+
+def handoff_curve(row: pd.Series, contact_is_end_stop: bool) -> dict:
+    """The row's torque curve up to where its path stops (the stop point is the last point): at the impact
+    torque, a limit point's maximum, contact; a hard stop when contact is the study's end stop."""
+    theta, torque = list(row["large_curve_rotation_rad"]), list(row["large_curve_torque_Nm"])
+    stop_theta, stop_torque = float(row["large_stop_rotation_rad"]), float(row["large_stop_torque_Nm"])
+    keep = [i for i, t in enumerate(theta) if t < stop_theta and (i == 0 or torque[i] < stop_torque)]
+    rotation, torques = [theta[i] for i in keep], [torque[i] for i in keep]
+    if stop_theta > rotation[-1] and stop_torque > torques[-1]:
+        rotation.append(stop_theta)
+        torques.append(stop_torque)
+    reason = str(row["large_stop_reason"])
+    return {"rotation_rad": rotation, "torque_Nm": torques, "source": "fea_large_deflection", "stop_reason": reason,
+            "hard_stop": reason == "contact" and contact_is_end_stop,
+            "note": "hyperelastic finite-strain FEA, hub rotated as the servo holds it, ring held; sampled at the "
+                    "path's converged increments, interpolated monotonically (PCHIP) by readers"}
+
+
+def large_deflection_block(row: pd.Series) -> dict:
+    """The row's `large_` scalars (prefix dropped, units in the keys); the curve travels in `torque_curve`."""
+    out = {}
+    for k, v in row.items():
+        if not k.startswith("large_") or k.startswith("large_curve_"):
+            continue
+        out[k[len("large_"):]] = v if isinstance(v, str) else bool(v) if isinstance(v, (bool, np.bool_)) else _number(v)
+    return out

@@ -1,18 +1,25 @@
 """Choose a candidate: hard constraints, physical objectives, Pareto front and weighted score.
 
+Everything is read from the large-deflection path (`large_` columns, `fea.large_deflection`), not
+from the linear model, which is far outside its range at these loads; the linear results stay in
+the table for comparison with the thesis.
+
 Objectives (both minimised):
-- accuracy: `stall_bearing_displacement_mm`, the bearing displacement under stall torque;
+- accuracy: `large_stall_bearing_displacement_mm`, the arc the bearing circle turns through at the
+  stall torque;
 - gearbox protection: `impact_gearbox_torque_Nm`, the peak torque a foot strike drives into the
   gearbox. The leg (inertia J about the knee, angular speed w = v / lower_leg at touchdown) is
-  stopped by the spring with the gearbox side held: J w^2 / 2 = tau^2 / (2 k), so
-  tau_peak = w sqrt(k J). The energy the spring stores at the impact torque, tau^2 / (2 k), is
-  reported beside it. A static reaction force cannot measure protection: in statics the whole
-  applied torque reaches the motor whatever k is (the thesis's 149-150 N for every design);
-  the thesis's reaction numbers are kept for comparison.
+  stopped by the spring with the gearbox side held: its kinetic energy J w^2 / 2 goes into the
+  spring, int_0^theta T dtheta, and the torque where the curve has stored it is the peak. (A linear
+  spring gives tau_peak = w sqrt(k J).) A curve that ends before it has stored that energy gives
+  no number: the strike reaches the path's stop. A static reaction force cannot measure protection:
+  in statics the whole applied torque reaches the motor whatever k is (the thesis's 149-150 N for
+  every design).
 
-For a linear spring both objectives depend on k alone (displacement ~ 1/k, impact torque ~
-sqrt(k)), so every feasible candidate with a distinct k lies on the Pareto front; the weighted
-score (weights from the study, min-max normalised objectives) picks the point on it.
+Hard constraints: valid geometry; solved; the path carries the stall and the impact torque (a stop
+before it, contact unless the study makes contact an end stop, a limit point or a buckling mode, fails
+the load); the peak strain at each load within the allowable strain (elongation at yield / safety
+factor); the standing deflection read from the curve; the study's k range (small-load k).
 """
 
 from __future__ import annotations
@@ -24,10 +31,12 @@ import numpy as np
 import pandas as pd
 
 from seadesign.constants import THESIS_FEA_RESULTS
+from seadesign.design.spring import TorqueCurve
 from seadesign.design.study import Study
 
-ACCURACY = "stall_bearing_displacement_mm"
+ACCURACY = "large_stall_bearing_displacement_mm"
 PROTECTION = "impact_gearbox_torque_Nm"
+CARRIED = "large_stop_torque_Nm"  # the order of a pool that no objective can rank: the most torque carried first
 
 
 @dataclass(frozen=True)
@@ -50,20 +59,24 @@ def pareto_front(objectives: np.ndarray) -> np.ndarray:
     return mask
 
 
+def strike_torque(rotation_rad, torque_Nm, energy_J: float) -> float:
+    """The torque (Nm) where a curve through (0, 0) has stored `energy_J` (J); NaN when it stores less."""
+    torque = TorqueCurve(tuple(rotation_rad), tuple(torque_Nm)).torque_at_energy(energy_J)
+    return math.nan if torque is None else torque
+
+
 def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
-    """Standing deflection, impact energy and gearbox impact torque, extrapolation flag, thesis numbers."""
+    """Standing deflection, impact energy and gearbox strike torque read from each curve, thesis numbers."""
     rk, robot = study.ranking, study.robot
     t = table.copy()
-    k = t["k_Nm_per_rad"] if "k_Nm_per_rad" in t else pd.Series(np.nan, index=t.index)
-    omega = rk.impact_speed_m_per_s / robot.lower_leg_m
+    energy = 0.5 * rk.knee_inertia_kg_m2 * (rk.impact_speed_m_per_s / robot.lower_leg_m) ** 2
+    solved = t["status"] == "ok"
     t["standing_knee_torque_Nm"] = robot.standing_knee_torque_Nm
-    t["standing_deflection_deg"] = np.degrees(robot.standing_knee_torque_Nm / k)
-    t["impact_energy_J"] = study.load_cases.impact_torque_Nm ** 2 / (2 * k)
-    t["impact_gearbox_torque_Nm"] = omega * np.sqrt(k * rk.knee_inertia_kg_m2)
-    rotations = t.reindex(columns=["stall_rotation_rad", "impact_rotation_rad"]).abs()
-    t["max_rotation_rad"] = rotations.max(axis=1, skipna=True)
-    t["extrapolation"] = t["max_rotation_rad"] > rk.small_deflection_limit_rad
-    t["small_deflection_limit_rad"] = rk.small_deflection_limit_rad
+    t["standing_deflection_deg"] = np.degrees(t["large_standing_rotation_rad"]) if "large_standing_rotation_rad" in t \
+        else np.nan
+    t["strike_energy_J"] = energy
+    t[PROTECTION] = [strike_torque(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], energy) if ok else np.nan
+                     for ok, (_, r) in zip(solved, t.iterrows())]
     thesis = [_thesis_result(study, row) for _, row in t.iterrows()]
     t["thesis_reaction_N"] = [r for r, _ in thesis]
     t["thesis_displacement_mm"] = [d for _, d in thesis]
@@ -78,26 +91,32 @@ def _thesis_result(study: Study, row: pd.Series) -> tuple[float, float]:
 
 def constraint_columns(t: pd.DataFrame, study: Study) -> pd.DataFrame:
     """One boolean column per hard constraint, `feasible`, and `failed_constraints` in words."""
-    rk = study.ranking
-    allowable = pd.Series([study.candidate_of_row(r).material.yield_strength_Pa / rk.safety_factor * 1e-6
-                           for _, r in t.iterrows()], index=t.index, dtype=float)
-    limit = f"{allowable.iloc[0]:.3g} MPa" if allowable.nunique() == 1 else "yield / safety factor"
+    rk, lc = study.ranking, study.load_cases
     solved = t["status"] == "ok"
-    col = t.reindex(columns=["stall_von_mises_max_MPa", "impact_von_mises_max_MPa"])
+
+    def col(name: str) -> pd.Series:
+        return t[name] if name in t else pd.Series(np.nan, index=t.index)
+
+    allowable = col("large_allowable_strain")
+    known = allowable[solved & allowable.notna()]
+    limit = f"{known.iloc[0]:.3g}" if known.nunique() == 1 else "the allowable"
     checks = {
         "valid geometry": t["status"] != "invalid",
         "solved": t["status"] != "failed",
-        f"stall stress < {limit}": solved & (col["stall_von_mises_max_MPa"] < allowable),
-        f"impact stress < {limit}": solved & (col["impact_von_mises_max_MPa"] < allowable),
-        f"standing deflection < {rk.max_standing_deflection_deg:g} deg":
-            solved & (t["standing_deflection_deg"] < rk.max_standing_deflection_deg),
     }
+    for case, torque in (("stall", lc.stall_torque_Nm), ("impact", lc.impact_torque_Nm)):
+        carried = solved & col(f"large_{case}_rotation_rad").notna()
+        strain = col(f"large_{case}_peak_strain")
+        checks[f"carries the {case} torque ({torque:.3g} Nm)"] = carried
+        # judged only where the load is carried (a load not carried fails once); no allowable: nothing to judge
+        checks[f"{case} strain < {limit}"] = ~carried | allowable.isna() | (strain <= allowable)
+    checks[f"standing deflection < {rk.max_standing_deflection_deg:g} deg"] = \
+        solved & (t["standing_deflection_deg"] < rk.max_standing_deflection_deg)
     if rk.k_min_Nm_per_rad is not None:
         checks[f"k >= {rk.k_min_Nm_per_rad:g} Nm/rad"] = solved & (t["k_Nm_per_rad"] >= rk.k_min_Nm_per_rad)
     if rk.k_max_Nm_per_rad is not None:
         checks[f"k <= {rk.k_max_Nm_per_rad:g} Nm/rad"] = solved & (t["k_Nm_per_rad"] <= rk.k_max_Nm_per_rad)
     t = t.copy()
-    t["allowable_stress_MPa"] = allowable
     gate = {"valid geometry": pd.Series(True, index=t.index), "solved": t["status"] != "invalid"}
     fails = pd.DataFrame({name: gate.get(name, solved) & ~ok.fillna(False).astype(bool) for name, ok in checks.items()})
     t["failed_constraints"] = ["; ".join(c for c in fails.columns if row[c]) for _, row in fails.iterrows()]
@@ -115,8 +134,10 @@ def _normalised(values: pd.Series) -> pd.Series:
 def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
     """Add physical, constraint, Pareto and score columns and choose a candidate.
 
-    The pool is the feasible candidates; when none is feasible, the solved candidates that fail
-    the fewest constraints (the choice is then marked infeasible and says what it violates).
+    The pool is the feasible candidates; when none is feasible, the solved candidates that fail the
+    fewest constraints (the choice is then marked infeasible and says what it violates). A pool in which
+    some candidate has no objective (its curve stops before the stall torque or before storing the
+    strike's energy) cannot be scored: it is ordered by the torque each carries before its path stops.
     """
     t = constraint_columns(physical_columns(table, study), study)
     rk = study.ranking
@@ -131,25 +152,45 @@ def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
     feasible = t["feasible"]
     pool = feasible if feasible.any() else solved & (t["n_failed_constraints"] == t.loc[solved, "n_failed_constraints"].min())
     p = t[pool]
-    t.loc[pool, "pareto"] = pareto_front(p[[ACCURACY, PROTECTION]].to_numpy())
-    acc, prot = _normalised(p[ACCURACY]), _normalised(p[PROTECTION])
-    w = rk.weight_accuracy + rk.weight_protection
-    t.loc[pool, "accuracy_score"] = acc
-    t.loc[pool, "protection_score"] = prot
-    t.loc[pool, "score"] = (rk.weight_accuracy * acc + rk.weight_protection * prot) / w
-    order = t[pool].sort_values(["score", ACCURACY], ascending=[False, True]).index
+    scored = bool(p[[ACCURACY, PROTECTION]].notna().all(axis=None))
+    if scored:
+        t.loc[pool, "pareto"] = pareto_front(p[[ACCURACY, PROTECTION]].to_numpy())
+        acc, prot = _normalised(p[ACCURACY]), _normalised(p[PROTECTION])
+        w = rk.weight_accuracy + rk.weight_protection
+        t.loc[pool, "accuracy_score"] = acc
+        t.loc[pool, "protection_score"] = prot
+        t.loc[pool, "score"] = (rk.weight_accuracy * acc + rk.weight_protection * prot) / w
+        order = t[pool].sort_values(["score", ACCURACY], ascending=[False, True]).index
+    else:
+        order = t[pool].sort_values([CARRIED, "k_Nm_per_rad"], ascending=[False, True]).index
     t.loc[order, "rank"] = np.arange(1, len(order) + 1)
     best = int(order[0])
     second = int(order[1]) if len(order) > 1 else None
-    return t, Choice(best, second, bool(feasible.any()), explain(t, best, second, bool(feasible.any())))
+    explanation = explain(t, best, second, bool(feasible.any())) if scored else _explain_carried(t, best, second)
+    return t, Choice(best, second, bool(feasible.any()), explanation)
+
+
+def _explain_carried(t: pd.DataFrame, best: int, second: int | None) -> str:
+    """Why a pool without objectives chose `best`: the most torque carried before the path stops."""
+    b = t.loc[best]
+    text = (f"No candidate meets every hard constraint, and the ones failing the fewest "
+            f"({int(b['n_failed_constraints'])}: {b['failed_constraints']}) cannot all be scored, so the choice is "
+            f"the one that carries the most torque before its path stops: {b['candidate']}, "
+            f"{b[CARRIED]:.3g} Nm at {b['large_stop_rotation_rad']:.3g} rad ({b['large_stop_reason']}; small-load "
+            f"k {b['k_Nm_per_rad']:.3g} Nm/rad).")
+    if second is not None:
+        r = t.loc[second]
+        text += f" Next: {r['candidate']}, {r[CARRIED]:.3g} Nm ({r['large_stop_reason']})."
+    return text
 
 
 def explain(t: pd.DataFrame, best: int, second: int | None, feasible: bool) -> str:
     """Why the chosen candidate wins and what the runner-up trades, in words."""
     b = t.loc[best]
     text = (f"{b['candidate']} wins with score {b['score']:.2f} (accuracy {b['accuracy_score']:.2f}, protection "
-            f"{b['protection_score']:.2f}): k = {b['k_Nm_per_rad']:.3g} Nm/rad, stall displacement "
-            f"{b[ACCURACY]:.3g} mm at the bearing, {b[PROTECTION]:.3g} Nm peak impact torque into the gearbox.")
+            f"{b['protection_score']:.2f}): {b['large_stall_rotation_rad']:.3g} rad at the stall torque "
+            f"(secant k {b['large_stall_secant_k_Nm_per_rad']:.3g} Nm/rad, small-load k {b['k_Nm_per_rad']:.3g}), "
+            f"{b[ACCURACY]:.3g} mm at the bearing, {b[PROTECTION]:.3g} Nm peak strike torque into the gearbox.")
     if not feasible:
         text = (f"No candidate meets every hard constraint; the choice is among those failing the fewest "
                 f"({int(b['n_failed_constraints'])}: {b['failed_constraints']}). ") + text
@@ -162,9 +203,6 @@ def explain(t: pd.DataFrame, best: int, second: int | None, feasible: bool) -> s
                  if (r[ACCURACY] < b[ACCURACY]) != (r[PROTECTION] < b[PROTECTION]) else
                  f" The runner-up {r['candidate']} (score {r['score']:.2f}) is {acc_word} ({r[ACCURACY]:.3g} mm) "
                  f"and {prot_word} ({r[PROTECTION]:.3g} Nm).")
-    if bool(b["extrapolation"]):
-        text += (f" Its rotation under load ({b['max_rotation_rad']:.2f} rad) exceeds the small-deflection limit "
-                 f"({b['small_deflection_limit_rad']:g} rad), so its linear results are an extrapolation.")
     return text
 
 

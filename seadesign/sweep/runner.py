@@ -29,8 +29,9 @@ from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.executors import default_jobs, execute
 from seadesign.run.interrupt import Interrupted, remove_partial_files
 from seadesign.run.progress import ProgressDisplay
-from seadesign.sweep.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key
-from seadesign.sweep.table import candidate_columns, fea_columns, geometry_columns
+from seadesign.sweep.path_stage import path_key, path_response
+from seadesign.sweep.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key, part_source
+from seadesign.sweep.table import candidate_columns, fea_columns, geometry_columns, path_columns
 
 
 @dataclass(frozen=True)
@@ -65,9 +66,10 @@ class SweepRun:
 
 def row_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
     """Hash of every input of one candidate's row (its axis values, geometry, mesh, material, loads,
-    solver, versions) and of the code that turns the stage outputs into the row (this module and
-    the table's columns)."""
-    return digest("row", candidate.values, fea_key(study, candidate, settings), geometry_key(study, candidate),
+    solver, large-deflection path, versions) and of the code that turns the stage outputs into the row
+    (this module and the table's columns)."""
+    return digest("row", candidate.values, fea_key(study, candidate, settings), path_key(study, candidate, settings),
+                  geometry_key(study, candidate),
                   study.load_cases, study.bearing_radius_mm, candidate.material, code_fingerprint(__name__))
 
 
@@ -86,8 +88,10 @@ def evaluate(job: Job, sink) -> dict:
         if not checked.valid:
             row.update(status="invalid", reason="; ".join(checked.reasons))
         else:
-            unit = fea_response(job.study, checked, part, job.settings, job.cache, stage)
+            part_of = part_source(job.study, checked, part, stage)
+            unit = fea_response(job.study, checked, part_of, job.settings, job.cache, stage)
             row.update(fea_columns(unit, job.study))
+            row.update(path_columns(path_response(job.study, checked, part_of, job.settings, job.cache, stage), job.study))
     except Exception as exc:  # noqa: BLE001 - a failing candidate is a result, not a crash
         row.update(status="failed", reason=f"{type(exc).__name__}: {exc}".strip(),
                    traceback=traceback.format_exc(limit=4))

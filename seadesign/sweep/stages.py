@@ -15,12 +15,12 @@ benchmarks/fea_convergence.py).
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
-import numpy as np
 
 from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
@@ -42,12 +42,14 @@ class SolverSettings:
 
     element_order: int = 2  # P2 tetrahedra
     linear_solver: str = "pardiso"  # "pardiso" or "scipy"
+    path_coarsening: float = 2.0  # edge-length ratio of the large-deflection path's mesh to the result mesh
+    path_formulation: str = "full"  # volumetric formulation of the path (fea.finite_strain), as CalculiX's C3D10
 
 
 @dataclass(frozen=True)
 class UnitResponse:
     """The FEA of one candidate at 1 Nm in each load case (scale with `results.at`), the error
-    estimate's coarse k, how the mesh and solve went, and vertex fields for renders."""
+    estimate's coarse k, and how the mesh and solve went."""
 
     results: LinearResults  # both load cases at 1 Nm
     k_coarse_Nm_per_rad: float  # k on a COARSENING times coarser mesh (error estimate of k)
@@ -56,10 +58,6 @@ class UnitResponse:
     mesh_mean_aspect_ratio: float
     mesh_target_edge_mm: float
     mesh_tetrahedralize_s: float
-    points_mm: np.ndarray  # (n, 3) mesh vertices
-    tets: np.ndarray  # (m, 4)
-    vertex_displacement_m: dict  # case -> (n, 3) displacement in m per Nm
-    vertex_von_mises_Pa: np.ndarray  # (n,) von Mises in Pa per Nm (same for both cases)
 
 
 def geometry_key(study: Study, candidate: Candidate) -> str:
@@ -108,7 +106,6 @@ def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache,
 def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, settings: SolverSettings) -> UnitResponse:
     """Both load cases at 1 Nm, and k on the coarse mesh for the error estimate."""
     from seadesign.fea.loadcases import analyse
-    from seadesign.fea.stress import invariants
     from seadesign.fea.torsion import solve_unit_torsion
 
     m = candidate.material
@@ -118,7 +115,6 @@ def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, setting
     t1 = time.perf_counter()
     coarse = solve_unit_torsion(coarse_mesh, m.youngs_modulus_Pa, m.poisson_ratio, order=settings.element_order,
                                 linear_solver=settings.linear_solver)
-    nv = a.unit.emesh.n_vertices
     return UnitResponse(
         results=a.results,
         k_coarse_Nm_per_rad=1.0 / float(coarse.hub_motion[5]),
@@ -127,27 +123,34 @@ def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, setting
         mesh_mean_aspect_ratio=mesh.quality.mean_aspect_ratio,
         mesh_target_edge_mm=mesh.info.get("target_edge_mm", float("nan")),
         mesh_tetrahedralize_s=mesh.info.get("tetrahedralize_s", float("nan")),
-        points_mm=mesh.points_mm,
-        tets=mesh.tets,
-        vertex_displacement_m={case: a.displacement_m(case)[:nv] for case in ("stall", "impact")},
-        vertex_von_mises_Pa=invariants(a.stress_per_Nm_Pa[:nv])["von_mises"],
     )
 
 
-def fea_response(study: Study, candidate: Candidate, part: Part | None, settings: SolverSettings, cache: Cache,
+def part_source(study: Study, candidate: Candidate, built: Part | None, progress: Progress) -> Callable[[], Part]:
+    """The candidate's CAD part as a function: `built` when the geometry stage made it, else built on the
+    first call (only a stage whose result is not cached asks), once."""
+
+    @functools.cache
+    def part() -> Part:
+        if built is not None:
+            return built
+        progress("geometry")
+        return study.check(candidate)[1]
+
+    return part
+
+
+def fea_response(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings, cache: Cache,
                  progress: Progress) -> UnitResponse:
-    """Unit response via the cache: the part (when not given) and the mesh (cached) are made only
-    when the solve is not cached."""
+    """Unit response via the cache: the part and the mesh (cached) are made only when the solve is not
+    cached."""
     fkey = fea_key(study, candidate, settings)
     unit = cache.get("fea", fkey)
     if unit is not None:
         return unit
-    if part is None:
-        progress("geometry")
-        _, part = study.check(candidate)
     progress("mesh")
-    mesh = tetrahedralize(study, candidate, part, cache)
-    coarse_mesh = tetrahedralize(study, candidate, part, cache, COARSENING)
+    mesh = tetrahedralize(study, candidate, part(), cache)
+    coarse_mesh = tetrahedralize(study, candidate, part(), cache, COARSENING)
     progress("fea")
     unit = unit_response(mesh, coarse_mesh, study, candidate, settings)
     cache.put("fea", fkey, unit)

@@ -2,7 +2,8 @@
 
 A row is: the candidate (name, one column per design axis, named by its key), its status and
 reason, its checked geometry (volume, mass), and, when solved, the linear FEA of both load cases
-at the study's torques (`fea.results` columns) with the quantities derived from them here.
+at the study's torques (`fea.results` columns) with the quantities derived from them here, and the
+large-deflection path read at the standing, stall and impact torques (`large_` columns).
 Ranking adds its own columns afterwards (`sweep/rank.py`).
 """
 
@@ -12,6 +13,8 @@ import math
 
 from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
+from seadesign.fea.results import columns
+from seadesign.sweep.path_stage import PathResponse
 from seadesign.sweep.stages import COARSENING, CONVERGENCE_ORDER, UnitResponse
 
 
@@ -49,3 +52,14 @@ def fea_columns(unit: UnitResponse, study: Study) -> dict[str, float]:
         "mesh_target_edge_mm": unit.mesh_target_edge_mm,
         "mesh_tetrahedralize_s": unit.mesh_tetrahedralize_s,
     }
+
+
+def path_columns(path: PathResponse, study: Study) -> dict:
+    """The large-deflection columns (`fea.large_deflection`, prefixed `large_`), with the stall bearing
+    displacement and foot error read from the path's stall rotation (the hub is rigid: arc length on the
+    bearing circle)."""
+    out = columns(path.result, "large_")
+    rotation = path.result.stall.rotation_rad
+    out["large_stall_bearing_displacement_mm"] = rotation * study.bearing_radius_mm
+    out["large_stall_foot_error_mm"] = rotation * study.load_cases.lower_leg_m * 1e3
+    return out

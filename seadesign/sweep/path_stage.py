@@ -1,0 +1,78 @@
+"""The large-deflection stage of a sweep: a candidate's torque path, read at its loads.
+
+The path (`fea.rotation_path`, the material's hyperelastic law) runs from rest to the study's impact
+torque or to where it stops, on a mesh `SolverSettings.path_coarsening` times coarser than the
+result mesh (its error against the result mesh is in the README's table). `fea.large_deflection`
+reads it at the standing, stall and impact torques. The result is cached under the mesh, the law,
+the path settings, the torques, the allowable strain, the end-stop rule and the code.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
+
+from seadesign.design.candidate import Candidate
+from seadesign.design.study import Study
+from seadesign.fea.finite_strain import Solid
+from seadesign.fea.large_deflection import LargeDeflection, large_deflection
+from seadesign.fea.rotation_path import PathSettings, rotation_path
+from seadesign.run.cache import Cache, digest, package_versions
+from seadesign.run.fingerprint import code_fingerprint
+from seadesign.sweep.stages import Progress, SolverSettings, mesh_key, tetrahedralize
+
+if TYPE_CHECKING:
+    from seadesign.design.geometry import Part
+
+
+@dataclass(frozen=True)
+class PathResponse:
+    """The path read at the loads, and the state a render shows: the first point that carries the stall
+    torque, or the last point when the path stops before it."""
+
+    result: LargeDeflection
+    points_mm: np.ndarray  # (n, 3) vertices of the path mesh
+    tets: np.ndarray  # (m, 4)
+    vertex_displacement_m: np.ndarray  # (n, 3) at the snapshot
+    vertex_strain: np.ndarray  # (n,) largest principal engineering strain of the elements at each vertex
+    snapshot_rotation_rad: float
+    snapshot_torque_Nm: float
+
+
+def path_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
+    """Inputs of the path: the mesh, the law, the path's mesh and settings, the torques, the allowable strain,
+    the end-stop rule and the code of this module with everything it imports."""
+    lc = study.load_cases
+    return digest("path", mesh_key(study, candidate), candidate.material.law, settings.path_coarsening,
+                  settings.path_formulation, PathSettings(), study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm,
+                  lc.impact_torque_Nm, candidate.material.allowable_strain(study.ranking.safety_factor),
+                  study.ranking.contact_is_end_stop, code_fingerprint(__name__), package_versions())
+
+
+def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings, cache: Cache,
+                  progress: Progress) -> PathResponse:
+    """The candidate's path via the cache (the part and the mesh are made only on a miss)."""
+    key = path_key(study, candidate, settings)
+    hit = cache.get("path", key)
+    if hit is not None:
+        return hit
+    progress("mesh")
+    mesh = tetrahedralize(study, candidate, part(), cache, settings.path_coarsening)
+    progress("path")
+    lc, m = study.load_cases, candidate.material
+    path = rotation_path(mesh, m.law, lc.impact_torque_Nm, PathSettings(), order=settings.element_order,
+                         formulation=settings.path_formulation, snapshot_torque_Nm=lc.stall_torque_Nm)
+    result = large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
+                              m.allowable_strain(study.ranking.safety_factor), study.ranking.contact_is_end_stop)
+    stretch = Solid.of(path.emesh, m.law, settings.path_formulation).element_strain_stress(
+        path.snapshot_displacement_m)[0]
+    nv = len(mesh.points_mm)
+    vertex_strain = np.zeros(nv)
+    np.maximum.at(vertex_strain, mesh.tets, (stretch - 1.0)[:, None])
+    shot = path.points[path.snapshot_index]
+    response = PathResponse(result, mesh.points_mm, mesh.tets, path.snapshot_displacement_m[:nv], vertex_strain,
+                            shot.rotation_rad, shot.torque_Nm)
+    cache.put("path", key, response)
+    return response
