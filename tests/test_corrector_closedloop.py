@@ -93,3 +93,34 @@ def test_iterate_adds_each_rounds_run_to_the_pool(spring_dict):
     assert np.isfinite(table["mean_abs_error_rad"]).all()
     again, _ = iterate(spring_dict, [], spec, cfg, rounds=2, trials=trials, seed=1)
     pd.testing.assert_frame_equal(table, again)  # seeded: the same rounds, numbers and flags
+
+
+def _softening(spring: dict) -> dict:
+    """spring.json with a large-deflection curve T = A tanh(theta / B) of the same small-load k (A / B = k),
+    A = 0.8 Nm: at the static knee's 0.45 Nm the deflection is 13 % above effort / k."""
+    a, b = 0.8, 0.8 / spring["k_Nm_per_rad"]
+    theta = np.linspace(0.0, 4 * b, 41)
+    curve = {"rotation_rad": list(theta), "torque_Nm": list(a * np.tanh(theta / b)), "source": "test",
+             "stop_reason": "target_reached", "hard_stop": False}
+    return {**spring, "schema_version": 2, "torque_curve": curve}
+
+
+def test_feedforward_with_the_torque_curve_cancels_a_softening_spring(spring_dict):
+    """As above with the curve as the spring's law: command = target + theta(tau) leaves -tau/Kp; effort / k
+    leaves the curve's extra deflection theta(tau) - tau / k, with theta = B atanh(tau / A) in closed form."""
+    from seadesign.design.spring import torque_curve
+
+    spring = _softening(spring_dict)
+    kp = KneeConfig.from_spring(spring).p_gain_Nm_per_rad
+    k, a, b = spring["k_Nm_per_rad"], 0.8, 0.8 / spring["k_Nm_per_rad"]
+    trial = [Trial("front", 0.0, 3.0)]
+    curve_ff = run_closed_loop(FeedForward(k, torque_curve(spring)), spring, trial, effects=_spring_only(spring),
+                               gait=STATIC)
+    k_ff = run_closed_loop(FeedForward(k), spring, trial, effects=_spring_only(spring), gait=STATIC)
+    for run, expected in ((curve_ff, lambda tau: -tau / kp),
+                          (k_ff, lambda tau: -(b * np.arctanh(tau / a) - tau / k) - tau / kp)):
+        assert not run.unstable and not run.oscillating
+        flex = run.hall[0, -1] * [1, -1] - run.target[0, -1] * [1, -1]
+        tau = run.effort[0, -1] * [1, -1]
+        assert np.all(np.abs(tau) > 0.4)  # loaded where the curve bends
+        np.testing.assert_allclose(flex, expected(tau), atol=1e-5)  # measured 2e-9 (curve), 2.6e-6 (k: PCHIP vs atanh)

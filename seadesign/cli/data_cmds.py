@@ -21,7 +21,7 @@ from seadesign.data import (
 )
 from seadesign.data.artefacts import Thresholds
 from seadesign.effects import EffectChain
-from seadesign.design.spring import load_spring
+from seadesign.design.spring import load_spring, torque_curve
 from seadesign.twin import (
     BenchProtocol,
     KneeConfig,
@@ -123,7 +123,8 @@ def simulate(spring_path: Path, protocol: str, ground: bool, seed: int, rate_hz:
 @click.option("--profile", type=click.Choice(["sine", "ramp"]), default="sine", show_default=True,
               help="Drive profile: sine or triangular ramp.")
 @click.option("--torque-amplitude-nm", type=float, default=4.8, show_default=True,
-              help="Peak torque the linear spring would reach, Nm.")
+              help="Peak spring torque of the drive, Nm (the rotation from the torque curve when spring.json has "
+                   "one, else from k).")
 @click.option("--frequency-hz", type=float, default=0.05, show_default=True, help="Drive frequency, Hz.")
 @click.option("--duration-s", type=float, default=120.0, show_default=True, help="Test length, s.")
 @click.option("--rate-hz", type=float, default=100.0, show_default=True, help="Sample rate, Hz.")
@@ -135,7 +136,7 @@ def simulate_bench_cmd(spring_path: Path, profile: str, torque_amplitude_nm: flo
                        duration_s: float, rate_hz: float, seed: int, effects: tuple[str, ...], output: Path) -> None:
     """Simulate a torque-deflection bench test of the spring in --spring."""
     spring = load_spring(spring_path)
-    chain = configure_chain(bench_effects(spring["k_Nm_per_rad"]), list(effects))
+    chain = configure_chain(bench_effects(spring["k_Nm_per_rad"], torque_curve(spring)), list(effects))
     protocol = BenchProtocol(profile, torque_amplitude_nm, frequency_hz, duration_s, rate_hz)
     df, meta = simulate_bench(spring, protocol, effects=chain, seed=seed)
     meta["spring_file"] = str(spring_path)

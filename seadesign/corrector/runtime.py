@@ -22,6 +22,7 @@ import numpy as np
 
 from seadesign.corrector.dataset import KNEES, DatasetSpec, FeatureBuilder
 from seadesign.corrector.export import NumpyCorrector
+from seadesign.design.spring import TorqueCurve
 from seadesign.errors import SeadesignError
 
 
@@ -65,15 +66,18 @@ class HallPI:
 
 
 class FeedForward:
-    """Physics feed-forward: command = target + lowpass(effort) / k (k in Nm/rad from spring.json,
-    filter time constant `filter_s` in s; 0 = unfiltered)."""
+    """Physics feed-forward: command = target + the spring's deflection under the lowpassed effort: effort / k
+    (k in Nm/rad from spring.json), or the large-deflection curve's rotation at that torque when spring.json
+    carries one (never extrapolated: an effort past its end is a CurveRangeError, or its end stop).
+    `filter_s`: filter time constant in s (0 = unfiltered)."""
 
-    def __init__(self, k_Nm_per_rad: float, filter_s: float = 0.1, name: str = "feedforward") -> None:
+    def __init__(self, k_Nm_per_rad: float, curve: TorqueCurve | None = None, filter_s: float = 0.1,
+                 name: str = "feedforward") -> None:
         if k_Nm_per_rad <= 0:
             raise SeadesignError(f"k_Nm_per_rad must be > 0, got {k_Nm_per_rad}")
         if filter_s < 0:
             raise SeadesignError(f"feed-forward filter time constant must be >= 0 s, got {filter_s}")
-        self.k, self.filter_s, self.name = k_Nm_per_rad, filter_s, name
+        self.k, self.curve, self.filter_s, self.name = k_Nm_per_rad, curve, filter_s, name
         self.reset()
 
     def reset(self) -> None:
@@ -84,7 +88,7 @@ class FeedForward:
         if prev is not None and self.filter_s > 0:
             tau = prev + (tau - prev) * min(1.0, dt_s / self.filter_s)
         self._effort[knee] = tau
-        return target_rad + tau / self.k
+        return target_rad + (tau / self.k if self.curve is None else float(self.curve.rotation(tau)))
 
 
 class NetCorrector:

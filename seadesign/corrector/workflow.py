@@ -26,7 +26,7 @@ from seadesign.corrector.runtime import Corrector, FeedForward, HallPI, NetCorre
 from seadesign.corrector.splits import Split, make_split
 from seadesign.corrector.train import TrainConfig, TrainResult, fit
 from seadesign.errors import SeadesignError
-from seadesign.design.spring import load_spring
+from seadesign.design.spring import load_spring, torque_curve
 from seadesign.twin import thesis_protocol
 
 DEFAULT_HISTORY = 3  # samples, for the history model when no --history is given
@@ -141,10 +141,15 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
     out = Path(out_dir) if out_dir else Path("exports") / ref_meta["spring"]["study"] / "corrector" / "evaluation"
     recs = load_recordings(data_paths)
     ds, split, rows_note = evaluation_rows(ref_meta, data_paths, recs)
-    correctors: list[Corrector] = [NoCorrection(), HallPI(kp, ki), FeedForward(k)] + [c for c, _ in nets]
+    spring_file = Path(ref_meta["spring"]["path"])
+    spring = load_spring(spring_file) if spring_file.exists() else None
+    curve = torque_curve(spring) if spring is not None else None
+    feed_forward = (f"the torque curve of {spring_file}" if curve is not None else
+                    f"k = {k:g} Nm/rad" + ("" if spring is not None else f" ({spring_file} not found)"))
+    correctors: list[Corrector] = [NoCorrection(), HallPI(kp, ki), FeedForward(k, curve)] + [c for c, _ in nets]
     table, traces = open_loop_table(correctors, recs, ds, split.test, split.name)
     context = {"rows": rows_note, "reference_bundle": str(bundles[0]), "data": data_record(data_paths),
-               "k_Nm_per_rad": k, "pi": {"kp": kp, "ki": ki}, "versions": versions(),
+               "k_Nm_per_rad": k, "feed_forward_spring": feed_forward, "pi": {"kp": kp, "ki": ki}, "versions": versions(),
                "candidates": {m["name"]: {"bundle": str(b), "training": m["training"], "split": m["split"]}
                               for b, (_, m) in zip(bundles, nets)}}
     files = write_table(table, out, "open_loop", context)
@@ -155,7 +160,7 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
     result = {"open_loop": table.to_dict("records"), "settings": context,
               "files": [str(p) for p in [*files.values(), *plots]]}
     if closed_loop:
-        spring = load_spring(ref_meta["spring"]["path"])
+        spring = load_spring(spring_file)  # a clear error when it is gone: the simulator needs it
         cl_table, _ = closed_loop_table(correctors, spring, closed_loop, thesis_protocol(trial_s), seed=seed)
         cl_context = {"protocol": f"thesis: 6 directions x 3 speeds, {trial_s:g} s each", "seed": seed,
                       "spring": ref_meta["spring"], "versions": versions()}

@@ -33,7 +33,7 @@ a chain holding only A (`chain.configure("B", enabled=False)`).
 from seadesign.effects.base import SIGNALS, Effect, Param, Scales, lowpass, lowpass_uniform
 from seadesign.effects.chain import EffectChain, effect_rng
 from seadesign.design.spring import CurveRangeError, TorqueCurve
-from seadesign.effects.curve import SpringCurve
+from seadesign.effects.curve import SpringCurve, spring_law
 from seadesign.effects.load import Friction, GravityLoad, StanceLoad
 from seadesign.effects.sensor import (
     AngleWrap,
@@ -70,5 +70,5 @@ __all__ = [
     "EffectChain", "EffortLag", "Friction", "GravityLoad", "LinearSpring", "Param", "Quantisation", "Scales",
     "SensorDelay", "SensorDrift", "SensorNoise", "SensorOffset", "SensorStep", "SpringCurve", "StanceLoad",
     "StiffnessScale", "TemperatureSoftening", "ThermalSoftening", "TorqueCurve", "Viscoelastic", "effect_rng",
-    "lowpass", "lowpass_uniform",
+    "lowpass", "lowpass_uniform", "spring_law",
 ]

@@ -20,6 +20,7 @@ import numpy as np
 
 from seadesign.design.spring import TorqueCurve
 from seadesign.effects.base import Effect, Param, Scales, Search
+from seadesign.effects.spring import LinearSpring
 
 
 class SpringCurve(Effect):
@@ -61,3 +62,9 @@ class SpringCurve(Effect):
                         "source": self.curve.source, "stop_reason": self.curve.stop_reason,
                         "hard_stop": self.curve.hard_stop}
         return out
+
+
+def spring_law(k_Nm_per_rad: float, curve: TorqueCurve | None = None, name: str = "spring") -> Effect:
+    """The spring's law: the large-deflection `curve` when there is one (never extrapolated: a rotation past
+    its end is a CurveRangeError, or the end stop when the curve has one), else k (Nm/rad)."""
+    return SpringCurve(curve, name) if curve is not None else LinearSpring(name, k_Nm_per_rad=k_Nm_per_rad)

@@ -144,15 +144,15 @@ def scaled(result: Any, factor: float) -> Any:
 
 
 def columns(result: Any, prefix: str = "") -> dict[str, Any]:
-    """Flat {column: value} of a results dataclass, nested names joined by "_": numbers as floats, flags and
-    words as they are, a tuple of numbers as a list."""
+    """Flat {column: value} of a results dataclass, nested names joined by "_": numbers as floats, flags,
+    counts and words as they are, a tuple of numbers as a list."""
     out: dict[str, Any] = {}
     for f in dataclasses.fields(result):
         value = getattr(result, f.name)
         if dataclasses.is_dataclass(value):
             inner = f.metadata.get("prefix")
             out.update(columns(value, prefix + (f"{f.name}_" if inner is None else inner)))
-        elif isinstance(value, (str, bool)):
+        elif isinstance(value, (str, bool, int)):  # words, flags and counts as they are
             out[prefix + f.name] = value
         elif isinstance(value, tuple):  # a curve's points: a list in the row and the parquet table
             out[prefix + f.name] = list(value)

@@ -22,20 +22,14 @@ from typing import Any
 import pandas as pd
 
 from seadesign.data import knee_channels
-from seadesign.effects import DeadBand, Effect, Friction, LinearSpring, SpringCurve, TorqueCurve
+from seadesign.design.spring import torque_curve
+from seadesign.effects import DeadBand, Effect, Friction, spring_law
 from seadesign.loop.engine import Explanation
 from seadesign.loop.table import LoopData, LoopInputError, smooth_rate
 from seadesign.twin.config import GEAR_COULOMB_NM
 
 #: the robot model's declared effects: library key -> name in the model
 ROBOT_DECLARED = {"dead_band": "backlash", "friction": "gear_friction"}
-
-
-def model_spring(spring: dict[str, Any]) -> Effect:
-    """The spring of a spring.json: its `torque_curve` when present (the large-deflection FEA), else k."""
-    if spring.get("torque_curve"):
-        return SpringCurve(TorqueCurve.from_handoff(spring["torque_curve"]), "spring")
-    return LinearSpring("spring", k_Nm_per_rad=float(spring["k_Nm_per_rad"]))
 
 
 def robot_declared(spring: dict[str, Any], keys: tuple[str, ...] = tuple(ROBOT_DECLARED)) -> list[Effect]:
@@ -62,14 +56,14 @@ def bench_loop_data(df: pd.DataFrame, spring: dict[str, Any], predict: str = "to
         signals["temperature"] = df["temperature_C"].to_numpy(float)
         columns["temperature"] = "temperature_C"
     if predict == "torque":
-        return LoopData(torque, {**signals, "deflection": defl}, "stiffness", spring=model_spring(spring),
+        return LoopData(torque, {**signals, "deflection": defl}, "stiffness", spring=spring_law(float(spring["k_Nm_per_rad"]), torque_curve(spring)),
                         sensor_on="deflection", measured_name="torque_Nm", measured_unit="Nm", units=units,
                         columns={**columns, "deflection": "deflection_rad", "measured": "torque_Nm"})
     if predict == "deflection":
         # the bench's friction acts against the deflection rate: from the reading (the torque's rate would carry the
         # friction's own jump); a Savitzky-Golay derivative, whose kernel leaves out the sample itself
         rate = smooth_rate(defl, time)
-        return LoopData(defl, {**signals, "torque": torque, "velocity": rate}, "compliance", spring=model_spring(spring),
+        return LoopData(defl, {**signals, "torque": torque, "velocity": rate}, "compliance", spring=spring_law(float(spring["k_Nm_per_rad"]), torque_curve(spring)),
                         measured_name="deflection_rad", measured_unit="rad", units=units,
                         columns={**columns, "torque": "torque_Nm", "measured": "deflection_rad",
                                  "velocity": "d(deflection_rad)/dt"})
@@ -82,7 +76,7 @@ def robot_loop_data(df: pd.DataFrame, spring: dict[str, Any], knee: str = "l") -
     return LoopData(
         ch["hall"], {"time": df["time_s"].to_numpy(float), "motor": ch["motor"], "motor_velocity": ch["motor_velocity"],
                      "effort": ch["effort"]},
-        "compliance", spring=model_spring(spring), base=ch["motor"], sign=-1.0,
+        "compliance", spring=spring_law(float(spring["k_Nm_per_rad"]), torque_curve(spring)), base=ch["motor"], sign=-1.0,
         measured_name=ch.columns["hall"], measured_unit="rad",
         units={"time": "s", "motor": "rad", "motor_velocity": "rad/s", "effort": "Nm"},
         columns={"measured": ch.columns["hall"], "time": "time_s",

@@ -7,7 +7,7 @@ Public API (stable):
   `recording()` returns the robot-format table, `metadata()` the sidecar dict (effects declared).
 - `simulate(spring, trials, **options) -> (table, metadata)`: the same, walk target relayed.
 - `Trial`, `thesis_protocol(duration_s, repeats)`, `DIRECTIONS`, `SPEEDS`, `Gait`: the walk protocol.
-- `KneeConfig`, `knee_effects(cfg, ground)`, `bench_effects(k)`, `configure_chain(chain, options)`.
+- `KneeConfig`, `knee_effects(cfg, ground)`, `bench_effects(k, curve)`, `configure_chain(chain, options)`.
 - `BenchProtocol`, `simulate_bench(spring, protocol, effects=, seed=) -> (table, metadata)`.
 
 Simulated tables are written with `seadesign.data.write_recording` / `write_bench` and the

@@ -20,7 +20,7 @@ import pandas as pd
 from seadesign import __version__
 from seadesign.effects import EffectChain
 from seadesign.errors import ConfigError
-from seadesign.design.spring import load_spring
+from seadesign.design.spring import TorqueCurve, load_spring, torque_curve
 from seadesign.twin.config import bench_effects
 
 PROFILES = ("sine", "ramp")
@@ -45,15 +45,18 @@ class BenchProtocol:
                 raise ConfigError(f"bench {name} = {getattr(self, name)} must be positive")
 
 
-def drive(protocol: BenchProtocol, k_Nm_per_rad: float) -> tuple[np.ndarray, np.ndarray]:
-    """Time (s) and driven deflection (rad) of the protocol."""
+def drive(protocol: BenchProtocol, k_Nm_per_rad: float, curve: TorqueCurve | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Time (s) and driven deflection (rad) of the protocol: the amplitude is the rotation at which the spring
+    (the torque curve when given, else k) carries the torque amplitude (a CurveRangeError past the curve's end)."""
     time = np.arange(int(round(protocol.duration_s * protocol.rate_hz))) / protocol.rate_hz
     phase = protocol.frequency_hz * time
     if protocol.profile == "sine":
         shape = np.sin(2 * np.pi * phase)
     else:
         shape = 2.0 / np.pi * np.arcsin(np.sin(2 * np.pi * phase))  # triangle, same peaks and zeros
-    return time, protocol.torque_amplitude_Nm / k_Nm_per_rad * shape
+    amplitude = protocol.torque_amplitude_Nm / k_Nm_per_rad if curve is None else \
+        float(curve.rotation(protocol.torque_amplitude_Nm))
+    return time, amplitude * shape
 
 
 def simulate_bench(spring: dict[str, Any] | str | Path, protocol: BenchProtocol = BenchProtocol(), *,
@@ -63,9 +66,9 @@ def simulate_bench(spring: dict[str, Any] | str | Path, protocol: BenchProtocol 
     The table has the bench format's columns `time_s, torque_Nm, deflection_rad`.
     """
     spring = load_spring(spring) if isinstance(spring, (str, Path)) else spring
-    k = float(spring["k_Nm_per_rad"])
-    chain = effects if effects is not None else bench_effects(k)
-    time, deflection = drive(protocol, k)
+    k, curve = float(spring["k_Nm_per_rad"]), torque_curve(spring)
+    chain = effects if effects is not None else bench_effects(k, curve)
+    time, deflection = drive(protocol, k, curve)
     signals = {"time": time, "deflection": deflection, "deflection_rate": np.gradient(deflection, time)}
     path = chain.run(signals, targets=("deflection", "torque"), seed=seed)
     sensed = chain.run({"time": time, "hall": deflection, "torque_sensor": path["torque"]},

@@ -19,7 +19,6 @@ from seadesign.effects import (
     EffortLag,
     Friction,
     GravityLoad,
-    LinearSpring,
     Quantisation,
     SensorDelay,
     SensorDrift,
@@ -30,7 +29,9 @@ from seadesign.effects import (
     StiffnessScale,
     ThermalSoftening,
     Viscoelastic,
+    spring_law,
 )
+from seadesign.design.spring import TorqueCurve, torque_curve
 from seadesign.constants import G_M_PER_S2
 from seadesign.errors import ConfigError
 
@@ -51,7 +52,7 @@ class KneeConfig:
     knee angle - 0.5 rad from vertical.
     """
 
-    k_Nm_per_rad: float
+    k_Nm_per_rad: float  # small-load stiffness
     stall_torque_Nm: float
     no_load_speed_rad_per_s: float
     backlash_rad: float
@@ -65,6 +66,7 @@ class KneeConfig:
     stance_weight_share: float = 0.5
     hip_flexion_rad: float = 0.5
     max_substep_s: float = 0.0025
+    torque_curve: TorqueCurve | None = None  # the large-deflection law when spring.json carries it (else k)
 
     @classmethod
     def from_spring(cls, spring: dict[str, Any], **overrides: Any) -> "KneeConfig":
@@ -77,6 +79,7 @@ class KneeConfig:
             mass_kg=robot["mass_kg"],
             lower_leg_m=robot["lower_leg_m"],
             upper_leg_m=robot["upper_leg_m"],
+            torque_curve=torque_curve(spring),
             **overrides,
         )
 
@@ -114,7 +117,7 @@ def knee_effects(cfg: KneeConfig, ground: bool = False) -> EffectChain:
     return EffectChain([
         DeadBand("backlash", width_rad=cfg.backlash_rad),
         DeadBand("dead_band", enabled=False),
-        LinearSpring("spring", k_Nm_per_rad=cfg.k_Nm_per_rad),
+        spring_law(cfg.k_Nm_per_rad, cfg.torque_curve),
         StiffnessScale("stiffness_scale", enabled=False),
         CubicStiffening("cubic_stiffening", enabled=False),
         DahlHysteresis("hysteresis", enabled=False),
@@ -139,12 +142,12 @@ def knee_effects(cfg: KneeConfig, ground: bool = False) -> EffectChain:
     ])
 
 
-def bench_effects(k_Nm_per_rad: float) -> EffectChain:
-    """The bench simulator's chain: spring on; dead-band, torque-path effects, friction, sensor
-    effects declared and off except torque and deflection noise."""
+def bench_effects(k_Nm_per_rad: float, curve: TorqueCurve | None = None) -> EffectChain:
+    """The bench simulator's chain: spring on (`curve` when given, else k); dead-band, torque-path effects,
+    friction, sensor effects declared and off except torque and deflection noise."""
     return EffectChain([
         DeadBand("dead_band", enabled=False),
-        LinearSpring("spring", k_Nm_per_rad=k_Nm_per_rad),
+        spring_law(k_Nm_per_rad, curve),
         StiffnessScale("stiffness_scale", enabled=False),
         CubicStiffening("cubic_stiffening", enabled=False),
         DahlHysteresis("hysteresis", enabled=False),
