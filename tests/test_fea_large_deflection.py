@@ -66,3 +66,12 @@ def test_columns_keep_words_flags_and_curves():
     assert c["large_stop_reason"] == "contact" and c["large_stall_survives"] is False
     assert c["large_curve_rotation_rad"] == [0.0, 0.25, 0.5] and math.isnan(c["large_stall_strain_margin"])
     assert c["large_standing_survives"] is True  # no allowable strain: nothing to fail
+
+
+def test_torque_and_rotation_at_are_inverse_readings_of_the_curve():
+    path = _path(1.5, "target_reached")
+    for theta in (0.013, 0.4, 1.49):
+        # cubic Hermite with exact tangents, points 0.0375 rad apart: measured 7.7e-7 Nm at most
+        assert path.torque_at(theta) == pytest.approx(A * math.tanh(theta / B), abs=2e-6)
+        assert path.rotation_at(path.torque_at(theta)) == pytest.approx(theta, abs=1e-12)
+    assert path.torque_at(1.6) is None and path.rotation_at(A) is None

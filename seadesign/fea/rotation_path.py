@@ -89,6 +89,13 @@ class TorquePath:
     snapshot_index: int = -1  # the point whose displacement is `snapshot_displacement_m` (see rotation_path)
     snapshot_displacement_m: np.ndarray | None = field(default=None, repr=False)
 
+    def torque_at(self, rotation_rad: float) -> float | None:
+        """Torque (Nm) at `rotation_rad` on the cubic Hermite curve through the points, None past the last."""
+        for a, b in zip(self.points, self.points[1:]):
+            if a.rotation_rad <= rotation_rad <= b.rotation_rad:
+                return float(_hermite(a, b, (rotation_rad - a.rotation_rad) / (b.rotation_rad - a.rotation_rad)))
+        return None
+
     def rotation_at(self, torque_Nm: float) -> float | None:
         """Rotation (rad) at which the path first carries `torque_Nm` (cubic Hermite between the bracketing
         points, with their tangents), None if it never does."""

@@ -1,0 +1,75 @@
+"""Mesh convergence of the large-deflection path: the curve, the contact onset and the peak strain.
+
+Usage: python benchmarks/path_convergence.py [--study wolfgang_knee] [--candidates 8x4,3x8]
+       [--coarsenings 3,2,1.5,1] [--rotations 0.1,0.2,0.3]
+Prints, per candidate and mesh (a coarsening of the study's mesh: 1 is the result mesh, 2 the sweep's
+path mesh), the degrees of freedom, the torque at each listed rotation (Nm), where and why the path stops
+(rad, Nm), the torque where the peak strain passes the allowable strain, the peak strain at the first listed
+rotation, the time, and each number's difference to the finest mesh's. Contact and strain peaks sit at beam
+roots (fillets), so they converge more slowly than the torque.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+
+import numpy as np
+
+from seadesign.design.study import load_study
+from seadesign.fea.large_deflection import large_deflection
+from seadesign.fea.rotation_path import PathSettings, rotation_path
+from seadesign.run.cache import Cache
+from seadesign.sweep.stages import check_geometry, tetrahedralize
+
+
+def _number(value: float | None) -> float:
+    return float("nan") if value is None else value
+
+
+def strain_at(path, theta: float) -> float:
+    return float(np.interp(theta, [p.rotation_rad for p in path.points], [p.peak_strain for p in path.points],
+                           right=np.nan))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--study", default="wolfgang_knee")
+    ap.add_argument("--candidates", default="8x4,3x8", help="beams x thickness_mm, comma separated")
+    ap.add_argument("--coarsenings", default="3,2,1.5,1", help="edge-length factors on the study's mesh")
+    ap.add_argument("--rotations", default="0.1,0.2,0.3", help="rotations (rad) where the torque is compared")
+    args = ap.parse_args()
+    st = load_study(args.study)
+    cache = Cache()
+    coarsenings = [float(c) for c in args.coarsenings.split(",")]
+    rotations = [float(r) for r in args.rotations.split(",")]
+    print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
+    print(f"study {st.name}, material {st.material.name} ({st.material.law.kind}), path settings {PathSettings()}")
+    for spec in args.candidates.split(","):
+        n, t = spec.split("x")
+        candidate, part = check_geometry(st, st.candidate(beam_count=int(n), beam_thickness_mm=float(t)), cache)
+        part = part or st.check(candidate)[1]
+        m, lc = candidate.material, st.load_cases
+        rows = []
+        for c in coarsenings:
+            mesh = tetrahedralize(st, candidate, part, cache, c)
+            path = rotation_path(mesh, m.law, lc.impact_torque_Nm, PathSettings())
+            ld = large_deflection(path, st.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
+                                  m.allowable_strain(st.ranking.safety_factor))
+            rows.append((c, ld.dofs, [_number(path.torque_at(r)) for r in rotations], path.stop_reason, ld.stop_rotation_rad,
+                         ld.stop_torque_Nm, ld.strain_limit_torque_Nm, strain_at(path, rotations[0]), path.time_s))
+        print(f"\n{candidate.name}: torque (Nm) at {', '.join(f'{r:g}' for r in rotations)} rad; stop; strain limit "
+              f"torque (Nm); peak strain at {rotations[0]:g} rad; in brackets: relative difference to coarsening "
+              f"{rows[-1][0]:g}")
+        ref = rows[-1]
+        for c, dofs, torques, reason, stop_rad, stop_Nm, limit_Nm, strain, secs in rows:
+            def rel(v, r):
+                return f"{v:.4g} [{(v - r) / r:+.2%}]"
+            print(f"  coarsening {c:<4g} {dofs:>8d} dofs  T " + ", ".join(rel(v, r) for v, r in zip(torques, ref[2]))
+                  + f"  stop {reason} {rel(stop_rad, ref[4])} rad {rel(stop_Nm, ref[5])} Nm  strain limit "
+                  f"{rel(limit_Nm, ref[6])} Nm  strain {rel(strain, ref[7])}  {secs:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
