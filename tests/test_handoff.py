@@ -72,3 +72,22 @@ def test_schema_2_carries_a_torque_curve(spring_dict):
 def test_bad_torque_curve_names_the_field(spring_dict, changes, problem):
     with pytest.raises(SpringFileError, match=problem):
         validate_spring(dict(spring_dict, schema_version=2, torque_curve=_curve(**changes)))
+
+
+@pytest.mark.parametrize("reason, end_stop, hard", [("limit_point", True, False), ("contact", False, False),
+                                                    ("contact", True, True)])
+def test_the_handed_curve_ends_at_the_paths_stop(reason, end_stop, hard):
+    """The sweep's row holds the converged points, the last one past the stop (a limit point is located from
+    both sides); spring.json gets the points before the stop and the stop itself, a valid monotone curve."""
+    import pandas as pd
+
+    from seadesign.design.spring import TorqueCurve
+    from seadesign.sweep.handoff import handoff_curve
+
+    row = pd.Series({"large_curve_rotation_rad": [0.0, 0.1, 0.2, 0.3, 0.31], "large_curve_torque_Nm":
+                     [0.0, 1.8, 3.2, 4.0, 3.99], "large_stop_rotation_rad": 0.303, "large_stop_torque_Nm": 4.01,
+                     "large_stop_reason": reason})
+    curve = handoff_curve(row, end_stop)
+    assert curve["rotation_rad"] == [0.0, 0.1, 0.2, 0.3, 0.303] and curve["torque_Nm"] == [0.0, 1.8, 3.2, 4.0, 4.01]
+    assert curve["stop_reason"] == reason and curve["hard_stop"] is hard
+    TorqueCurve.from_handoff(curve)  # strictly increasing from (0, 0)
