@@ -42,6 +42,7 @@ def test_loads_reached_are_read_from_the_curve():
     assert ld.strain_limit_rotation_rad == pytest.approx(0.866, abs=1e-9)
     assert ld.strain_limit_torque_Nm == pytest.approx(A * math.tanh(0.866 / B), rel=1e-3)
     assert ld.peak_strain == pytest.approx(0.75) and ld.peak_von_mises_MPa == pytest.approx(3.0)
+    assert ld.peak_log_strain == pytest.approx(math.log(1.75))
     assert math.isnan(ld.contact_rotation_rad) and ld.increments == 40 and ld.newton_iterations == 123
 
 

@@ -63,7 +63,8 @@ class LargeDeflection:
     allowable_strain: float = unscaled()  # NaN: the material has no sourced elongation at yield
     strain_limit_rotation_rad: float = unscaled()  # where the peak strain passes the allowable (NaN: never)
     strain_limit_torque_Nm: float = unscaled()
-    peak_strain: float = unscaled()  # over the whole path
+    peak_strain: float = unscaled()  # over the whole path (engineering: largest stretch - 1)
+    peak_log_strain: float = unscaled()  # the same peak as a logarithmic strain, ln(stretch)
     peak_strain_at: PeakLocation = nested()
     peak_von_mises_MPa: float = unscaled()  # Cauchy von Mises, over the whole path
     peak_von_mises_at: PeakLocation = nested()
@@ -145,6 +146,7 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
         strain_limit_rotation_rad=limit_theta,
         strain_limit_torque_Nm=float(np.interp(limit_theta, theta, torque)) if math.isfinite(limit_theta) else math.nan,
         peak_strain=worst_strain.peak_strain,
+        peak_log_strain=math.log1p(worst_strain.peak_strain),
         peak_strain_at=_location(path, worst_strain.peak_strain_element),
         peak_von_mises_MPa=worst_stress.peak_von_mises_Pa * 1e-6,
         peak_von_mises_at=_location(path, worst_stress.peak_von_mises_element),
