@@ -1,9 +1,15 @@
 """Stage-by-stage timing of one candidate at the study's mesh size, and CalculiX on the same mesh.
 
 Usage: python benchmarks/fea.py [--study wolfgang_knee] [--beams 8] [--thickness-mm 6]
-       [--elements-across-beam N] [--backend gmsh|pytetwild] [--no-ccx]
+       [--coarsening C] [--elements-across-beam N] [--backend gmsh|pytetwild] [--no-ccx]
+       [--no-path] [--max-rotation-rad 0.4]
 Prints machine, settings, per-stage seconds and the ratio (our assembly + factorization + solve)
-/ (ccx wall time, which includes its own input reading, assembly and solve).
+/ (ccx wall time, which includes its own input reading, assembly and solve). Then the
+large-deflection path (fea.rotation_path, to the stall torque or where it stops, no strain stop):
+its time split into assembly / factorization / solve / stop checks (the solver's methods timed from
+here, the library unchanged), Newton iterations per increment, and CalculiX NLGEOM on the same mesh
+and rotations with the time ratio and the torque agreement. --coarsening C makes every mesh size C
+times coarser, as the sweep's error-estimate mesh (C = 4: a few minutes in all).
 """
 
 from __future__ import annotations
@@ -14,14 +20,56 @@ import platform
 import shutil
 import tempfile
 import time
+from collections import defaultdict
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 
-from seadesign.fea.ccx import run_ccx, write_load_case_decks
+from seadesign.fea import rotation_path as rp
+from seadesign.fea.assembly import UpperBlocks
+from seadesign.fea.ccx import path_nodes, run_ccx, run_ccx_path, write_load_case_decks, write_path_inp
+from seadesign.fea.finite_strain import Solid
 from seadesign.fea.loadcases import analyse
+from seadesign.fea.pardiso import Pardiso
 from seadesign.mesh import mesh_part
 from seadesign.design.study import load_study
+
+# the path's time split: the methods timed in each part (a method called inside another is not nested here)
+PATH_PARTS = {
+    "assembly (forces, tangent, energy)": [(Solid, "forces"), (Solid, "tangent"), (Solid, "tangent_product"),
+                                           (Solid, "energy"), (UpperBlocks, "matrix")],
+    "factorization (LDL^T with inertia)": [(Pardiso, "__init__"), (Pardiso, "refactor")],
+    "solve": [(Pardiso, "solve")],
+    "stop checks (peak strain, contact gap)": [(Solid, "peak_principal_strain"), (rp, "_min_gap_mm")],
+}
+
+
+@contextmanager
+def timed(parts: dict) -> Iterator[dict]:
+    """Wrap the listed methods to add their seconds and calls to {part: [s, calls]}; restored on exit."""
+    totals: dict = defaultdict(lambda: [0.0, 0])
+    saved = []
+    for part, methods in parts.items():
+        for owner, name in methods:
+            original = getattr(owner, name)
+            saved.append((owner, name, original))
+
+            def wrapper(*a, _f=original, _part=part, **k):
+                t = time.perf_counter()
+                try:
+                    return _f(*a, **k)
+                finally:
+                    totals[_part][0] += time.perf_counter() - t
+                    totals[_part][1] += 1
+
+            setattr(owner, name, wrapper)
+    try:
+        yield totals
+    finally:
+        for owner, name, original in saved:
+            setattr(owner, name, original)
 
 
 def main() -> None:
@@ -29,13 +77,17 @@ def main() -> None:
     ap.add_argument("--study", default="wolfgang_knee")
     ap.add_argument("--beams", type=int, default=8)
     ap.add_argument("--thickness-mm", type=float, default=6.0)
+    ap.add_argument("--coarsening", type=float, default=1.0, help="every mesh size this many times coarser")
     ap.add_argument("--elements-across-beam", type=float)
     ap.add_argument("--backend", choices=["gmsh", "pytetwild"], default="gmsh")
     ap.add_argument("--no-ccx", action="store_true")
+    ap.add_argument("--no-path", action="store_true", help="skip the large-deflection path")
+    ap.add_argument("--max-rotation-rad", type=float, default=0.4, help="where the path stops at the latest")
     args = ap.parse_args()
     st = load_study(args.study)
-    across = args.elements_across_beam or st.mesh.elements_across_beam
-    per_circle = st.mesh.elements_per_circle if args.backend == "gmsh" else 0.0
+    sizing = st.mesh.scaled(1.0 / args.coarsening)
+    across = args.elements_across_beam or sizing.elements_across_beam
+    per_circle = sizing.elements_per_circle if args.backend == "gmsh" else 0.0
     m, lc = st.material, st.load_cases
 
     stages: dict[str, float] = {}
@@ -48,7 +100,7 @@ def main() -> None:
         t = time.perf_counter()
         mesh = mesh_part(part.solid, part.interfaces, across, args.thickness_mm,
                          cache_dir=cache, backend=args.backend, elements_per_circle=per_circle,
-                         layers=st.mesh.mesh_part_options()["layers"] if args.backend == "gmsh" else 0)
+                         layers=sizing.mesh_part_options()["layers"] if args.backend == "gmsh" else 0)
         t_mesh = time.perf_counter() - t
     stages["tessellation / BREP export"] = mesh.info["geometry_s"]
     stages["tetrahedralization (child process)"] = mesh.info["tetrahedralize_s"]
@@ -65,7 +117,7 @@ def main() -> None:
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.1f}; python {platform.python_version()}")
     print(f"candidate: {args.beams} beams / {args.thickness_mm:g} mm ({st.name}), material {m.name}")
-    print(f"mesh: {args.backend}, {across:g} elements across the beam -> {mesh.info['target_edge_mm']:.3g} mm, "
+    print(f"mesh: {args.backend}, coarsening {args.coarsening:g}: {across:g} elements across the beam -> {mesh.info['target_edge_mm']:.3g} mm, "
           f"{per_circle:g} per turn on curved surfaces; "
           f"{mesh.quality.n_tets} tets, {mesh.quality.n_nodes} vertices, {int(r['dofs'])} P2 dofs, "
           f"min dihedral {mesh.quality.min_dihedral_deg:.1f} deg, max aspect {mesh.quality.max_aspect_ratio:.2f}")
@@ -75,9 +127,17 @@ def main() -> None:
     total = sum(stages.values())
     print(f"{'full candidate (both load cases, all outputs)':<44}{total:>9.2f}")
     print(f"k = {r['k_Nm_per_rad']:.5g} Nm/rad, equilibrium error {r['equilibrium_rel_error']:.1e}")
-    if args.no_ccx or shutil.which("ccx") is None:
+    use_ccx = not args.no_ccx and shutil.which("ccx") is not None
+    if not use_ccx:
         print("CalculiX: skipped" + ("" if args.no_ccx else " (ccx not on PATH)"))
-        return
+    else:
+        linear_ccx(a, m, lc, r)
+    if not args.no_path:
+        path_benchmark(mesh, m, lc, args.max_rotation_rad, use_ccx)
+
+
+def linear_ccx(a, m, lc, r: dict) -> None:
+    """CalculiX on the linear stall case: time, k and displacement agreement."""
     with tempfile.TemporaryDirectory() as d:
         decks = write_load_case_decks(Path(d), a.unit, m.youngs_modulus_Pa, m.poisson_ratio,
                                       lc.stall_torque_Nm, lc.impact_torque_Nm)
@@ -89,6 +149,44 @@ def main() -> None:
           f"(rel. diff {abs(lc.stall_torque_Nm / cc.rotation_rad / r['k_Nm_per_rad'] - 1):.1e}), "
           f"max |du| / max |u| = {np.abs(cc.displacement_m - u).max() / np.abs(u).max():.1e}")
     print(f"ours (assembly + factorization + solve) / CalculiX = {ours:.2f} / {cc.wall_s:.2f} = {ours / cc.wall_s:.2f}")
+
+
+def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool) -> None:
+    """The large-deflection path with its time split, and CalculiX NLGEOM at the path's rotations."""
+    law = m.law
+    with timed(PATH_PARTS) as parts:
+        path = rp.rotation_path(mesh, law, lc.stall_torque_Nm, rp.PathSettings(max_rotation_rad=max_rotation_rad))
+    points = path.points[1:]
+    its = np.array([p.iterations for p in points])
+    factorizations = parts["factorization (LDL^T with inertia)"][1]
+    print(f"large-deflection path (neo-Hooke C10 {law.c10_Pa / 1e6:.3g} MPa, D1 {law.d1_per_Pa * 1e6:.3g} 1/MPa; "
+          f"formulation full; to {lc.stall_torque_Nm:g} Nm or {max_rotation_rad:g} rad): stopped by {path.stop_reason} "
+          f"at {path.stop_rotation_rad:.4f} rad, {path.stop_torque_Nm:.4g} Nm")
+    print(f"{len(points)} increments accepted, {path.cut_backs} cut back; Newton iterations per accepted increment "
+          f"{its.mean():.2f} (max {its.max()}); {factorizations} iterations in all, counted as tangent factorizations "
+          f"(cut-back attempts included); MKL threads "
+          f"{os.environ.get('MKL_NUM_THREADS') or os.environ.get('OMP_NUM_THREADS') or os.cpu_count()}")
+    print(f"{'path part':<44}{'s':>9}{'ms / iteration':>20}")
+    for name, (s, _) in parts.items():
+        print(f"{name:<44}{s:>9.2f}{1e3 * s / factorizations:>20.1f}")
+    other = path.time_s - sum(s for s, _ in parts.values())
+    print(f"{'other (set-up, predictor, bookkeeping)':<44}{other:>9.2f}{1e3 * other / factorizations:>20.1f}")
+    print(f"{'path total':<44}{path.time_s:>9.2f}{1e3 * path.time_s / factorizations:>20.1f}")
+    if not use_ccx:
+        return
+    theta = [p.rotation_rad for p in points]
+    emesh, hub, ring = path_nodes(mesh, law)
+    with tempfile.TemporaryDirectory() as d:
+        cc = run_ccx_path(write_path_inp(Path(d) / "path.inp", emesh, hub, ring, law, theta), emesh.nodes_m, theta)
+    n = len(cc.torque_Nm)
+    diff = np.abs(cc.torque_Nm / np.array([p.torque_Nm for p in points[:n]]) - 1)
+    print(f"CalculiX NLGEOM {os.cpu_count()} threads (SPOOLES), same mesh, the path's {len(theta)} rotations: "
+          f"{cc.wall_s:.2f} s wall, {cc.increments} increments, {cc.iterations} iterations "
+          f"({cc.iterations / cc.increments:.2f} per increment, {1e3 * cc.wall_s / cc.iterations:.0f} ms each)"
+          + (f"; did not converge: {cc.failure}" if cc.failure else ""))
+    print(f"torque: max |T_ccx / T_ours - 1| = {diff.max():.1e} over {n} rotations to {theta[n - 1]:.4f} rad "
+          f"(at the last: {diff[-1]:.1e})")
+    print(f"ours (path total) / CalculiX = {path.time_s:.2f} / {cc.wall_s:.2f} = {path.time_s / cc.wall_s:.2f}")
 
 
 if __name__ == "__main__":

@@ -1,9 +1,13 @@
-"""CalculiX (ccx) as an independent solver on the same mesh: input writer, runner, .dat parser.
+"""CalculiX (ccx) as an independent solver on the same mesh: input writers, runners, .dat parser.
 
-The deck is in SI units (m, N, Pa): C3D10 elements in the same node order as ours, node sets
-HUB and RING for the coupled surfaces, the hub tied to a reference point by *RIGID BODY
-(kinematically rigid, like an RBE2), the ring held, and a unit-scaled moment about +z on the
-rigid body's rotation node.
+Decks are in SI units (m, N, Pa): C3D10 elements in the same node order as ours, node sets HUB
+and RING for the coupled surfaces.
+- Linear torsion (`write_inp`): the hub tied to a reference point by *RIGID BODY (kinematically
+  rigid, like an RBE2), the ring held, and a moment about +z on the rigid body's rotation node.
+- The large-deflection path (`write_path_inp`), the check of `fea.rotation_path`: *HYPERELASTIC
+  with the law's constants, one *STEP, NLGEOM per requested rotation theta, each hub node driven
+  to x' = R(theta) x about z (no translation, no tilt, as the servo holds it), the ring held;
+  the reaction torque is read from the hub nodes' reaction forces.
 """
 
 from __future__ import annotations
@@ -14,17 +18,34 @@ import subprocess
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Sequence, TextIO
 
 import numpy as np
 
+from seadesign.design.materials import Hyperelastic
 from seadesign.errors import SolverError
 from seadesign.fea.elements import ElementMesh
+from seadesign.fea.rotation_path import PathSettings, _moment_z, _problem
 from seadesign.fea.torsion import UnitTorsion
+from seadesign.mesh.tetmesh import TetMesh
 
 
 def _block(ids: np.ndarray, per_line: int = 16) -> str:
     ids = np.asarray(ids) + 1
     return "\n".join(", ".join(map(str, ids[i : i + per_line])) for i in range(0, len(ids), per_line))
+
+
+def _write_mesh(f: TextIO, emesh: ElementMesh, hub_nodes: np.ndarray, ring_nodes: np.ndarray) -> None:
+    """Nodes (set NALL), C3D10 elements (set EALL) and the node sets HUB and RING, numbered ours + 1."""
+    if emesh.order != 2:
+        raise SolverError("the CalculiX export writes C3D10 elements; build the mesh with order 2")
+    f.write("*NODE, NSET=NALL\n")
+    np.savetxt(f, np.column_stack([np.arange(1, len(emesh.nodes_m) + 1), emesh.nodes_m]),
+               fmt=["%d", "%.12e", "%.12e", "%.12e"], delimiter=", ")
+    f.write("*ELEMENT, TYPE=C3D10, ELSET=EALL\n")
+    np.savetxt(f, np.column_stack([np.arange(1, len(emesh.elements) + 1), emesh.elements + 1]), fmt="%d", delimiter=", ")
+    f.write(f"*NSET, NSET=HUB\n{_block(hub_nodes)}\n")
+    f.write(f"*NSET, NSET=RING\n{_block(ring_nodes)}\n")
 
 
 def write_inp(
@@ -44,26 +65,17 @@ def write_inp(
     Node and element numbers are ours + 1; the two extra nodes N+1 (reference) and N+2 (rotation)
     carry the rigid body's translation and rotation (its dofs 1-3 are rotations about x, y, z).
     """
-    if emesh.order != 2:
-        raise SolverError("the CalculiX export writes C3D10 elements; build the mesh with order 2")
     if loaded not in ("hub", "ring"):
         raise SolverError(f"loaded side must be 'hub' or 'ring', got {loaded!r}")
     coupled, held = ("HUB", "RING") if loaded == "hub" else ("RING", "HUB")
     n = len(emesh.nodes_m)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    nodes = np.column_stack([np.arange(1, n + 1), emesh.nodes_m])
-    elems = np.column_stack([np.arange(1, len(emesh.elements) + 1), emesh.elements + 1])
     ref = ", ".join(f"{c:.12e}" for c in ref_m)
     with open(path, "w") as f:
         f.write(f"*HEADING\nseadesign torsion: {coupled} rigid with a moment about +z, {held} held; units m, N, Pa\n")
-        f.write("*NODE, NSET=NALL\n")
-        np.savetxt(f, nodes, fmt=["%d", "%.12e", "%.12e", "%.12e"], delimiter=", ")
+        _write_mesh(f, emesh, hub_nodes, ring_nodes)
         f.write(f"*NODE, NSET=REFNODES\n{n + 1}, {ref}\n{n + 2}, {ref}\n")
-        f.write("*ELEMENT, TYPE=C3D10, ELSET=EALL\n")
-        np.savetxt(f, elems, fmt="%d", delimiter=", ")
-        f.write(f"*NSET, NSET=HUB\n{_block(hub_nodes)}\n")
-        f.write(f"*NSET, NSET=RING\n{_block(ring_nodes)}\n")
         f.write(f"*MATERIAL, NAME=SPRING\n*ELASTIC\n{youngs_modulus_Pa:.12e}, {poisson_ratio:.12e}\n")
         f.write("*SOLID SECTION, ELSET=EALL, MATERIAL=SPRING\n")
         f.write(f"*RIGID BODY, NSET={coupled}, REF NODE={n + 1}, ROT NODE={n + 2}\n")
@@ -89,28 +101,31 @@ class CcxResult:
     wall_s: float
 
 
-def _dat_blocks(text: str) -> dict[str, list[list[float]]]:
-    """Numeric rows after each text header of a .dat file, keyed by the header."""
-    blocks: dict[str, list[list[float]]] = {}
-    current = None
+def _dat_sections(text: str) -> list[tuple[str, list[list[float]]]]:
+    """Each text header of a .dat file with the numeric rows after it, in file order."""
+    sections: list[tuple[str, list[list[float]]]] = []
     for line in text.splitlines():
         s = line.strip()
         if not s:
             continue
         if s[0].isalpha():
-            current = s
-            blocks[current] = []
-        elif current is not None:
-            blocks[current].append([float(v) for v in s.replace("D", "E").split()])
-    return blocks
+            sections.append((s, []))
+        elif sections:
+            sections[-1][1].append([float(v) for v in s.replace("D", "E").split()])
+    return sections
 
 
-def run_ccx(inp: Path, n_nodes: int, timeout_s: float = 600.0, threads: int | None = None) -> CcxResult:
-    """Run ccx on a deck from write_inp and parse its .dat (needs `ccx` on PATH)."""
+def _dat_blocks(text: str) -> dict[str, list[list[float]]]:
+    """Numeric rows after each text header of a .dat file, keyed by the header."""
+    return dict(_dat_sections(text))
+
+
+def _run(inp: Path, timeout_s: float, threads: int | None) -> tuple[subprocess.CompletedProcess, float]:
+    """Run ccx on a deck (needs `ccx` on PATH) with `threads` threads (default: all cores): the
+    finished process and its wall time (s)."""
     exe = shutil.which("ccx")
     if exe is None:
         raise SolverError("CalculiX `ccx` is not on PATH; install it (Debian: apt-get install calculix-ccx)")
-    inp = Path(inp)
     env = dict(os.environ)
     nproc = str(threads or os.cpu_count() or 1)
     env.update(OMP_NUM_THREADS=nproc, CCX_NPROC_EQUATION_SOLVER=nproc)
@@ -120,12 +135,21 @@ def run_ccx(inp: Path, n_nodes: int, timeout_s: float = 600.0, threads: int | No
             [exe, "-i", inp.stem], cwd=inp.parent, env=env, capture_output=True, text=True, timeout=timeout_s
         )
     except subprocess.TimeoutExpired:
-        raise SolverError(f"ccx did not finish within {timeout_s} s") from None
-    wall = time.perf_counter() - t0
+        raise SolverError(f"ccx did not finish within {timeout_s} s; raise timeout_s or coarsen the mesh") from None
+    return proc, time.perf_counter() - t0
+
+
+def _tail(proc: subprocess.CompletedProcess, lines: int = 15) -> str:
+    return "\n".join((proc.stdout + proc.stderr).splitlines()[-lines:])
+
+
+def run_ccx(inp: Path, n_nodes: int, timeout_s: float = 600.0, threads: int | None = None) -> CcxResult:
+    """Run ccx on a deck from write_inp and parse its .dat (needs `ccx` on PATH)."""
+    inp = Path(inp)
+    proc, wall = _run(inp, timeout_s, threads)
     dat = inp.with_suffix(".dat")
     if proc.returncode != 0 or not dat.exists() or "ERROR" in proc.stdout:
-        tail = "\n".join((proc.stdout + proc.stderr).splitlines()[-15:])
-        raise SolverError(f"ccx failed (exit {proc.returncode}):\n{tail}")
+        raise SolverError(f"ccx failed (exit {proc.returncode}):\n{_tail(proc)}")
     blocks = _dat_blocks(dat.read_text())
     disp = np.array(next(v for k, v in blocks.items() if k.startswith("displacements") and "NALL" in k))
     ref = {int(r[0]): r[1:4] for r in next(v for k, v in blocks.items() if k.startswith("displacements") and "REFNODES" in k)}
@@ -160,3 +184,125 @@ def write_load_case_decks(
         )
         for case, torque, side in (("stall", stall_torque_Nm, "hub"), ("impact", impact_torque_Nm, "ring"))
     }
+
+
+def path_nodes(mesh: TetMesh, law: Hyperelastic, hub_boundaries: list[str] | None = None,
+               ring_boundaries: list[str] | None = None) -> tuple[ElementMesh, np.ndarray, np.ndarray]:
+    """The P2 element mesh (m) and the driven hub and held ring nodes (0-based) of `rotation_path`
+    on `mesh` with these boundaries, taken from the path's own set-up (which builds its solid from
+    `law`) so that a deck drives and holds the same nodes."""
+    p = _problem(mesh, law, PathSettings(), 2, hub_boundaries, ring_boundaries, None, "full")
+    return p.solid.mesh, p.hub, np.setdiff1d(np.flatnonzero(p.node_index < 0), p.hub)
+
+
+_NEVER = 10**9  # a print frequency no step reaches: ccx then prints each step's last increment only
+
+
+@dataclass(frozen=True)
+class PathIncrements:
+    """Automatic incrementation of each NLGEOM step in rad of hub rotation (a step's time is its
+    rotation): each step starts with its whole rotation, at most `max_rad`, and ccx cuts back down to
+    `min_rad`; `residual_rtol` is ccx's convergence criterion, its largest residual force over its
+    average nodal force (ccx's default, 0.005, left torque errors of 1.2e-6 on the test annulus; 1e-7
+    leaves only the .dat's printed digits, 6e-8, for one more iteration in six)."""
+
+    max_rad: float = 0.1
+    min_rad: float = 1e-6
+    residual_rtol: float = 1e-7
+
+
+def write_path_inp(
+    path: Path,
+    emesh: ElementMesh,
+    hub_nodes: np.ndarray,
+    ring_nodes: np.ndarray,
+    law: Hyperelastic,
+    rotations_rad: Sequence[float],
+    increments: PathIncrements = PathIncrements(),
+) -> Path:
+    """Write a CalculiX NLGEOM deck of the rotation path: the neo-Hookean law (C10 in Pa, D1 in 1/Pa;
+    C3D10 integrates it at every point, as the path's formulation "full"), the ring nodes held, the hub
+    nodes' u_z = 0, and one *STEP, NLGEOM per rotation (rad, increasing) that ends with every hub node
+    at x' = R(theta) x about z (within a step the displacements ramp linearly: only step ends are
+    read). Each step prints the hub nodes' displacements and reaction forces at its end only."""
+    if law.model != "neo_hooke":
+        raise SolverError(f"the NLGEOM export writes *HYPERELASTIC, NEO HOOKE; the law is {law.model!r} "
+                          "(use a neo-Hookean law, e.g. Hyperelastic.from_linear)")
+    theta = np.asarray(rotations_rad, dtype=float)
+    if theta.ndim != 1 or not len(theta) or theta[0] <= 0 or np.any(np.diff(theta) <= 0):
+        raise SolverError(f"rotations_rad must be positive and increasing, got {theta}")
+    hub = np.asarray(hub_nodes)
+    x, y = emesh.nodes_m[hub, 0], emesh.nodes_m[hub, 1]
+    ids, dofs = np.repeat(hub + 1, 2), np.tile([1, 2], len(hub))
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w") as f:
+        f.write("*HEADING\nseadesign rotation path: HUB turned about +z (x' = R(theta) x), RING held; NLGEOM; "
+                "units m, N, Pa\n")
+        _write_mesh(f, emesh, hub, ring_nodes)
+        f.write(f"*MATERIAL, NAME=SPRING\n*HYPERELASTIC, NEO HOOKE\n{law.c10_Pa:.12e}, {law.d1_per_Pa:.12e}\n")
+        f.write("*SOLID SECTION, ELSET=EALL, MATERIAL=SPRING\n*BOUNDARY\nRING, 1, 3\nHUB, 3, 3\n")
+        for before, t in zip(np.concatenate([[0.0], theta[:-1]]), theta):
+            c, s = np.cos(t), np.sin(t)
+            u = np.column_stack([(c - 1) * x - s * y, s * x + (c - 1) * y]).ravel()
+            span = t - before
+            first, rtol = min(increments.max_rad, span), increments.residual_rtol
+            f.write(f"*STEP, NLGEOM, INC={int(np.ceil(span / increments.min_rad)) + 1}\n*STATIC\n"
+                    f"{first:.12e}, {span:.12e}, {increments.min_rad:.12e}, {first:.12e}\n")
+            f.write(f"*CONTROLS, PARAMETERS=FIELD\n{rtol:.3e}, , , , {rtol:.3e}\n*BOUNDARY\n")
+            np.savetxt(f, np.column_stack([ids, dofs, dofs, u]), fmt=["%d", "%d", "%d", "%.12e"], delimiter=", ")
+            f.write(f"*NODE PRINT, NSET=HUB, FREQUENCY={_NEVER}\nU, RF\n*END STEP\n")
+    return path
+
+
+@dataclass(frozen=True)
+class CcxPath:
+    """CalculiX's torque-rotation path: the requested rotations (rad) whose steps converged, in order,
+    and the reaction torque about z (Nm) there; `failure` is ccx's message when a step did not
+    converge (that rotation and the later ones are absent), None when all did. Increments and
+    Newton iterations count every attempt (cut-back ones too); wall time in s."""
+
+    rotation_rad: np.ndarray
+    torque_Nm: np.ndarray
+    failure: str | None
+    increments: int
+    iterations: int
+    wall_s: float
+
+
+def run_ccx_path(inp: Path, nodes_m: np.ndarray, rotations_rad: Sequence[float], timeout_s: float = 3600.0,
+                 threads: int | None = None) -> CcxPath:
+    """Run a deck from write_path_inp (the same rotations; `nodes_m` the mesh's nodes, m) and read the
+    torque of each converged step: sum over the hub nodes of (x + u) x RF, z component, as the path's
+    `_Problem.torque`. Steps ccx did not converge are left out and named in `failure`."""
+    inp = Path(inp)
+    theta = np.asarray(rotations_rad, dtype=float)
+    proc, wall = _run(inp, timeout_s, threads)
+    dat, sta, cvg = (inp.with_suffix(e) for e in (".dat", ".sta", ".cvg"))
+    errors = [line.strip() for line in proc.stdout.splitlines() if "ERROR" in line]
+    if not dat.exists() or not sta.exists() or (proc.returncode != 0 and not errors):
+        raise SolverError(f"ccx failed (exit {proc.returncode}) before any step:\n{_tail(proc)}")
+    sections = _dat_sections(dat.read_text())
+    disp = [(k, v) for k, v in sections if k.startswith("displacements")]
+    forces = [v for k, v in sections if k.startswith("forces")]
+    printed = np.array([float(k.rsplit(maxsplit=1)[1]) for k, _ in disp])
+    n = len(printed)
+    if n > len(theta) or not np.allclose(printed, theta[:n], rtol=1e-6, atol=0.0):
+        raise SolverError(f"ccx printed steps at {printed} rad, not the requested {theta}; "
+                          "was the deck written by write_path_inp with these rotations?")
+    if (n < len(theta)) != bool(errors):
+        raise SolverError(f"ccx converged {n} of {len(theta)} steps, exit {proc.returncode}:\n{_tail(proc)}")
+    torque = []
+    for (_, u), f in zip(disp, forces):
+        u, f = np.array(u), np.array(f)
+        if not np.array_equal(u[:, 0], f[:, 0]):
+            raise SolverError("ccx printed displacements and reaction forces of different hub nodes")
+        torque.append(_moment_z(nodes_m[u[:, 0].astype(int) - 1] + u[:, 1:4], f[:, 1:4]))
+    return CcxPath(
+        rotation_rad=theta[:n],
+        torque_Nm=np.array(torque),
+        failure=f"{'; '.join(errors)} (step to {theta[n]:.6g} rad)" if errors else None,
+        increments=len(sta.read_text().splitlines()) - 2,
+        iterations=sum(1 for line in cvg.read_text().splitlines()[4:] if line.split()),
+        wall_s=wall,
+    )
