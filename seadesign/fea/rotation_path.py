@@ -379,7 +379,7 @@ def rotation_path(
             located = step <= (settings.contact_locate_tol_rad if event == "contact" else settings.locate_tol_rad)
             if status == "unstable" and located:
                 reason = "bifurcation"
-            elif status != "converged" or (event not in (None, "target_reached") and not located):
+            elif status != "converged" or (event not in (None, "target_reached", "rotation_limit") and not located):
                 # not converged, or an event (limit point, contact, strain limit) to be located more closely
                 cuts += 1
                 step *= 0.5
