@@ -13,7 +13,7 @@ from seadesign.design.materials import Hyperelastic
 from seadesign.fea.assembly import stiffness_upper
 from seadesign.fea.couplings import couple
 from seadesign.fea.linsolve import full_from_upper
-from seadesign.fea.rotation_path import PathSettings, _problem, rotation_path
+from seadesign.fea.rotation_path import PathSettings, path_problem, rotation_path
 from seadesign.fea.torsion import MM
 
 A_MM, B_MM, H_MM, E = 10.0, 20.0, 4.0, 12e6
@@ -88,7 +88,7 @@ def test_tangent_at_rest_equals_the_linear_k_with_the_same_hub_constraints():
     # the linear solver's rigid coupling with the hub's translation and tilt held: k = 1 / (K^-1)_zz
     mesh = annulus_mesh(5.0, 12.0, 3.0, n_r=3, n_theta=16, n_z=2)
     path = rotation_path(mesh, Hyperelastic.from_linear(E, 0.48), 1e-3)
-    p = _problem(mesh, Hyperelastic.from_linear(E, 0.48), PathSettings(), 2, None, None, None, "full")
+    p = path_problem(mesh, Hyperelastic.from_linear(E, 0.48), PathSettings(), 2, None, None, None, "full")
     em = p.solid.mesh
     ring = np.setdiff1d(np.flatnonzero(p.node_index < 0), p.hub)
     cpl = couple(em.nodes_m, p.hub, ring, np.array([0.0, 0.0, 1.5e-3]))
@@ -107,7 +107,7 @@ def test_a_thin_plate_in_torsion_stops_where_the_tangent_loses_stability():
     law = Hyperelastic.from_linear(E, 0.45)
     path = rotation_path(mesh, law, 50.0, PathSettings(max_step_rad=0.05))
     assert path.stop_reason == "bifurcation"
-    p = _problem(mesh, law, PathSettings(), 2, None, None, None, "full")
+    p = path_problem(mesh, law, PathSettings(), 2, None, None, None, "full")
 
     def smallest(u):
         k = full_from_upper(p.solid.tangent(u, p.node_index, len(p.free)).matrix()).tocsc()

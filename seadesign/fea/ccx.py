@@ -25,7 +25,7 @@ import numpy as np
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import SolverError
 from seadesign.fea.elements import ElementMesh
-from seadesign.fea.rotation_path import PathSettings, _moment_z, _problem
+from seadesign.fea.rotation_path import PathSettings, moment_z, path_problem
 from seadesign.fea.torsion import UnitTorsion
 from seadesign.mesh.tetmesh import TetMesh
 
@@ -191,7 +191,7 @@ def path_nodes(mesh: TetMesh, law: Hyperelastic, hub_boundaries: list[str] | Non
     """The P2 element mesh (m) and the driven hub and held ring nodes (0-based) of `rotation_path`
     on `mesh` with these boundaries, taken from the path's own set-up (which builds its solid from
     `law`) so that a deck drives and holds the same nodes."""
-    p = _problem(mesh, law, PathSettings(), 2, hub_boundaries, ring_boundaries, None, "full")
+    p = path_problem(mesh, law, PathSettings(), 2, hub_boundaries, ring_boundaries, None, "full")
     return p.solid.mesh, p.hub, np.setdiff1d(np.flatnonzero(p.node_index < 0), p.hub)
 
 
@@ -297,7 +297,7 @@ def run_ccx_path(inp: Path, nodes_m: np.ndarray, rotations_rad: Sequence[float],
         u, f = np.array(u), np.array(f)
         if not np.array_equal(u[:, 0], f[:, 0]):
             raise SolverError("ccx printed displacements and reaction forces of different hub nodes")
-        torque.append(_moment_z(nodes_m[u[:, 0].astype(int) - 1] + u[:, 1:4], f[:, 1:4]))
+        torque.append(moment_z(nodes_m[u[:, 0].astype(int) - 1] + u[:, 1:4], f[:, 1:4]))
     return CcxPath(
         rotation_rad=theta[:n],
         torque_Nm=np.array(torque),

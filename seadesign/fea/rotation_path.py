@@ -138,7 +138,7 @@ class _Problem:
 
     def torque(self, u: np.ndarray, f: np.ndarray) -> float:
         """Reaction torque about z (Nm) that holds the hub: sum of x' x f over the hub nodes."""
-        return _moment_z(self.solid.mesh.nodes_m[self.hub] + u[self.hub], f[self.hub])
+        return moment_z(self.solid.mesh.nodes_m[self.hub] + u[self.hub], f[self.hub])
 
     def converged(self, f: np.ndarray, residual_norm: float) -> bool:
         """Whether the out-of-balance force is within the tolerance of the hub's reaction forces."""
@@ -173,7 +173,7 @@ class _Problem:
             self.pardiso.close()
 
 
-def _moment_z(x: np.ndarray, f: np.ndarray) -> float:
+def moment_z(x: np.ndarray, f: np.ndarray) -> float:
     """z component of sum x x f (Nm) over rows of positions x (m) and forces f (N)."""
     return float(np.sum(x[:, 0] * f[:, 1] - x[:, 1] * f[:, 0]))
 
@@ -285,7 +285,7 @@ def _state(p: _Problem, u: np.ndarray, f: np.ndarray, theta: float, iterations: 
     v[p.free] = -fac.solve(p.residual(p.solid.tangent_product(u, v))).reshape(-1, 3)
     df = p.solid.tangent_product(u, v, rows=p.hub)  # dT/dtheta needs the hub's rows only
     xd = p.solid.mesh.nodes_m[p.hub] + u[p.hub]
-    dT = _moment_z(v[p.hub], f[p.hub]) + _moment_z(xd, df[p.hub])
+    dT = moment_z(v[p.hub], f[p.hub]) + moment_z(xd, df[p.hub])
     stretch, mises = p.solid.element_strain_stress(u)
     i, j = int(np.argmax(stretch)), int(np.argmax(mises))
     gap, gap_at = _min_gap_mm(p, u)
@@ -294,9 +294,12 @@ def _state(p: _Problem, u: np.ndarray, f: np.ndarray, theta: float, iterations: 
     return point, v
 
 
-def _problem(mesh: TetMesh, law: Hyperelastic, settings: PathSettings, order: int,
-             hub_boundaries: list[str] | None, ring_boundaries: list[str] | None,
-             axially_held_faces: np.ndarray | None, formulation: str) -> _Problem:
+def path_problem(mesh: TetMesh, law: Hyperelastic, settings: PathSettings, order: int,
+                 hub_boundaries: list[str] | None, ring_boundaries: list[str] | None,
+                 axially_held_faces: np.ndarray | None, formulation: str) -> _Problem:
+    """The numbering and fixed data of a path on `mesh` (mm): the element mesh, the hub and ring nodes
+    (the study's interfaces unless named), the free nodes, the surface for contact (the CalculiX check
+    drives and holds the same nodes)."""
     default_hub, default_ring = default_boundaries(mesh)
     emesh = element_mesh(mesh.points_mm * MM, mesh.tets, order)
 
@@ -358,7 +361,7 @@ def rotation_path(
     if not target_torque_Nm > 0:
         raise SolverError(f"target_torque_Nm must be positive, got {target_torque_Nm:g}")
     t0 = time.perf_counter()
-    p = _problem(mesh, law, settings, order, hub_boundaries, ring_boundaries, axially_held_faces, formulation)
+    p = path_problem(mesh, law, settings, order, hub_boundaries, ring_boundaries, axially_held_faces, formulation)
     u = np.zeros_like(p.solid.mesh.nodes_m)
     try:
         first, v = _state(p, u, np.zeros_like(u), 0.0, 0, [0.0])
