@@ -45,7 +45,7 @@ def main() -> None:
     coarsenings = [float(c) for c in args.coarsenings.split(",")]
     rotations = [float(r) for r in args.rotations.split(",")]
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
-    print(f"study {st.name}, material {st.material.name} ({st.material.law.kind}), path settings {PathSettings()}")
+    print(f"study {st.name}, material {st.material.name} ({st.material.law.model}, C10 {st.material.law.c10_Pa / 1e6:.3g} MPa, D1 {st.material.law.d1_per_Pa * 1e6:.3g} 1/MPa), path settings {PathSettings()}")
     for spec in args.candidates.split(","):
         n, t = spec.split("x")
         candidate, part = check_geometry(st, st.candidate(beam_count=int(n), beam_thickness_mm=float(t)), cache)
