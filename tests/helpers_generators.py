@@ -140,9 +140,11 @@ def robot(effects: dict[str, dict[str, float]], seed: int = 1, duration_s: float
 
     The link follows `link_motion`; the spring carries what the link needs: inertia (0.0158 kg m^2), gravity
     (0.96 Nm sin(q - 0.9), the leg hanging at 0.9 rad) and link damping 0.05 Nm s/rad, so the torque reverses
-    twice a cycle. Motor = link + spring deflection (+ half the backlash towards the torque). Effort = spring
-    torque + gear friction (motor side), lagged by the servo's filter. Hall = link angle through the sensor
-    effects; noise 0.002 rad (Hall), 0.05 Nm (effort), 12-bit quantisation of both angles.
+    twice a cycle. The spring's deflection is solved from that torque: k (scaled), with thermal softening, a Dahl
+    loop, a Maxwell arm or a cubic term (one of these at a time). Motor = link + spring deflection (+ half the
+    backlash towards the torque). Effort = spring torque + gear friction (motor side), lagged by the servo's filter.
+    Hall = link angle through the sensor effects; noise 0.002 rad (Hall), 0.05 Nm (effort), 12-bit quantisation of
+    both angles.
     """
     rng = np.random.default_rng(seed + 1000)
     e = effects
