@@ -37,6 +37,38 @@ def _dahl(d: np.ndarray, torque: float, stiffness: float) -> np.ndarray:
     return out
 
 
+def _dahl_from_torque(tau: np.ndarray, k: float, torque: float, stiffness: float) -> np.ndarray:
+    """Deflection d of a spring k d + z = tau with a Dahl loop z (dz/dd = sigma (1 - z sign(dd) / tau_h)) driven
+    by the torque: dd = dtau / (k + sigma (1 - z s / tau_h)), s = sign(dtau), by explicit Euler, each sample's
+    torque step cut into substeps of at most a fiftieth of tau_h min(1, k / sigma) (at least 50; the bound keeps
+    the near-saturated stretch, rate sigma / (k tau_h), stable); z(0) = 0."""
+    z, d, out = 0.0, tau[0] / k, np.empty_like(tau)
+    out[0] = d
+    for i in range(1, tau.size):
+        step = tau[i] - tau[i - 1]
+        sub = max(50, int(np.ceil(50 * abs(step) / torque * max(1.0, stiffness / k))))
+        h = step / sub
+        for _ in range(sub):
+            slope = stiffness * (1 - z * np.sign(h) / torque)
+            dd = h / (k + slope)
+            z += slope * dd
+            d += dd
+        out[i] = d
+    return out
+
+
+def _maxwell_from_torque(tau: np.ndarray, dt: float, k: float, k2: float, tr: float, sub: int = 20) -> np.ndarray:
+    """Deflection d of a spring k with a Maxwell arm (k2, relaxation time tr) in parallel carrying tau:
+    tau = k d + k2 (d - r), r' = (d - r) / tr, by explicit Euler in r with `sub` substeps per sample (tau held);
+    relaxed at the start, r(0) = d(0) = tau(0) / k."""
+    r, out, h = tau[0] / k, np.empty_like(tau), dt / sub
+    for i, ti in enumerate(tau):
+        for _ in range(sub if i else 0):
+            r += h * ((ti + k2 * r) / (k + k2) - r) / tr
+        out[i] = (ti + k2 * r) / (k + k2)
+    return out
+
+
 def bench(effects: dict[str, dict[str, float]], seed: int = 1, duration_s: float = 60.0, rate_hz: float = 100.0,
           frequency_hz: float = 0.1, torque_amplitude_Nm: float = 4.8, k: float = K, harmonic: bool = True) -> pd.DataFrame:
     """A torque-deflection bench test: the deflection driven by two sines (`frequency_hz` and 3.7 times it, 70 / 30 %
@@ -108,9 +140,11 @@ def robot(effects: dict[str, dict[str, float]], seed: int = 1, duration_s: float
 
     The link follows `link_motion`; the spring carries what the link needs: inertia (0.0158 kg m^2), gravity
     (0.96 Nm sin(q - 0.9), the leg hanging at 0.9 rad) and link damping 0.05 Nm s/rad, so the torque reverses
-    twice a cycle. Motor = link + spring deflection (+ half the backlash towards the torque). Effort = spring
-    torque + gear friction (motor side), lagged by the servo's filter. Hall = link angle through the sensor
-    effects; noise 0.002 rad (Hall), 0.05 Nm (effort), 12-bit quantisation of both angles.
+    twice a cycle. The spring's deflection is solved from that torque: k (scaled), with thermal softening, a Dahl
+    loop, a Maxwell arm or a cubic term (one of these at a time). Motor = link + spring deflection (+ half the
+    backlash towards the torque). Effort = spring torque + gear friction (motor side), lagged by the servo's filter.
+    Hall = link angle through the sensor effects; noise 0.002 rad (Hall), 0.05 Nm (effort), 12-bit quantisation of
+    both angles.
     """
     rng = np.random.default_rng(seed + 1000)
     e = effects
@@ -129,6 +163,12 @@ def robot(effects: dict[str, dict[str, float]], seed: int = 1, duration_s: float
         spring_defl = tau / (k_true * (1 - p["softening_per_J"] * h))
     else:
         spring_defl = tau / k_true
+    if "hysteresis" in e:
+        p = e["hysteresis"]
+        spring_defl = _dahl_from_torque(tau, k_true, p["torque_Nm"], p["stiffness_Nm_per_rad"])
+    if "viscoelastic" in e:
+        p = e["viscoelastic"]
+        spring_defl = _maxwell_from_torque(tau, t[1], k_true, p["maxwell_stiffness_Nm_per_rad"], p["relaxation_time_s"])
     if "cubic_stiffening" in e:  # k d + k3 d^3 = tau, by Newton from the linear deflection
         k3 = e["cubic_stiffening"]["k3_Nm_per_rad3"]
         for _ in range(30):

@@ -36,15 +36,16 @@ CASES = {
 }
 # relative tolerance per (mode, effect): about three times the worst error measured over the three draws
 # (in brackets). The dead-band in the deflection direction is biased low (6-8 %): inside the zone the torque is
-# zero and says nothing about where the deflection is. Friction in the deflection direction: see the ambiguity test.
+# zero and says nothing about where the deflection is. Friction in the deflection direction is not drawn here: see
+# the Dahl-loop test below.
 TOL = {
     "torque": {"dead_band": 0.03,  # [0.0089]
                "stiffness_scale": 0.001,  # [0.00034]
                "cubic_stiffening": 0.01,  # [0.0028]
                "hysteresis": 0.02,  # [0.0062]
                "viscoelastic": 0.004,  # [0.0011]
-               "thermal_softening": 0.012,  # [0.0040]
-               "temperature_softening": 0.008,  # [0.0026]
+               "thermal_softening": 0.013,  # [0.0043]
+               "temperature_softening": 0.013,  # [0.0045]
                "friction": 0.02,  # [0.0059]
                "sensor_offset": 0.01,  # [0.0029]
                "sensor_drift": 0.03,  # [0.0099]
@@ -53,10 +54,10 @@ TOL = {
     "deflection": {"dead_band": 0.2,  # [0.084]
                    "stiffness_scale": 0.0012,  # [0.00037]
                    "cubic_stiffening": 0.012,  # [0.0039]
-                   "hysteresis": 0.15,  # [0.052]
+                   "hysteresis": 0.01,  # [0.0034]
                    "viscoelastic": 0.003,  # [0.0009]
-                   "thermal_softening": 0.04,  # [0.0127]
-                   "temperature_softening": 0.008,  # [0.0025]
+                   "thermal_softening": 0.04,  # [0.0131]
+                   "temperature_softening": 0.014,  # [0.0046]
                    "sensor_offset": 0.01,  # [0.0029]
                    "sensor_drift": 0.03,  # [0.010]
                    "sensor_delay": 0.005,  # [0.0017]
@@ -92,23 +93,25 @@ def test_bench_effect_named_alone_and_recovered(mode, key, draw_index):
     got = ex.final.parameters()[key][CASES[key][0]]["value"]
     assert got == pytest.approx(value, rel=TOL[mode][key])
     if key == "sensor_step":
-        assert ex.final.parameters()[key]["time_s"]["value"] == pytest.approx(case_effects(key, draw_index)[0][key]["time_s"], abs=0.011)
+        # the instant is the jump's sample (measured: exactly, every draw)
+        assert ex.final.parameters()[key]["time_s"]["value"] == pytest.approx(case_effects(key, draw_index)[0][key]["time_s"], abs=1e-9)
 
 
-def test_coulomb_friction_and_a_dahl_loop_on_a_slow_sine_are_one_ambiguity():
-    """A Dahl loop that saturates within a fraction of a sample's travel (sigma 5000 Nm/rad) is a torque of
-    +-tau_h flipping at each reversal: on one slow sine, with the torque as the input (deflection mode), Coulomb
-    friction in the torque reading is the same thing. The report names both as one ambiguity with both fits."""
+def test_a_fast_dahl_loop_is_told_from_coulomb_friction_by_the_torque_jump():
+    """A Dahl loop that saturates within a fraction of a sample's travel (sigma 5000 Nm/rad) is a torque of +-tau_h
+    flipping at each reversal of one slow sine, as Coulomb friction in the torque reading would be. With the torque
+    as the input (deflection mode) the loop, sharing the torque with the spring, holds the deflection while the
+    torque swings by 2 tau_h (20 times its noise); friction keys on the noisy deflection rate instead. Measured:
+    held-out RMSE 0.00143 rad with the loop, 0.00424 with friction (2.96 times), tau_h 0.43 % off. (Before the loop
+    shared the torque, the two were one ambiguity.)"""
     df = bench({"hysteresis": {"torque_Nm": 0.2, "stiffness_Nm_per_rad": 5000.0}}, seed=3, frequency_hz=0.05,
                harmonic=False)
     ex = explain(bench_loop_data(df, {"k_Nm_per_rad": K}, "deflection"), max_steps=2)
-    assert ex.ambiguities and set(ex.ambiguities[0]) == {"friction", "hysteresis"}, ex.verdict()
-    assert "cannot tell them apart" in ex.verdict()
-    step = ex.steps[0]
-    fits = {step.effect: step.after.parameters()[step.effect],
-            step.alternative.effect: step.alternative.fit.parameters()[step.alternative.effect]}
-    assert fits["friction"]["coulomb_Nm"]["value"] == pytest.approx(0.2, rel=0.1)
-    assert fits["hysteresis"]["torque_Nm"]["value"] == pytest.approx(0.2, rel=0.1)
+    assert ex.found == ["hysteresis"] and not ex.ambiguities, ex.verdict()
+    assert ex.final.parameters()["hysteresis"]["torque_Nm"]["value"] == pytest.approx(0.2, rel=0.013)
+    friction = next(t for t in ex.steps[0].trace if t.effect == "friction")
+    assert friction.fit.parameters()["friction"]["coulomb_Nm"]["value"] == pytest.approx(0.2, rel=0.01)  # [0.0030]
+    assert friction.held_out_rmse > 2 * ex.final.errors["held_out"]["rmse"]
 
 
 @pytest.mark.parametrize("width, k3, first", [(0.08, 4.0, "dead_band"), (0.02, 25.0, "cubic_stiffening")],
@@ -118,8 +121,8 @@ def test_two_undeclared_effects_found_in_either_order(width, k3, first):
     df = bench({"dead_band": {"width_rad": width}, "cubic_stiffening": {"k3_Nm_per_rad3": k3}}, seed=4)
     ex = explain(bench_loop_data(df, {"k_Nm_per_rad": K}), max_steps=3)
     assert ex.found[0] == first and sorted(ex.found) == ["cubic_stiffening", "dead_band"], ex.verdict()
-    p = ex.final.parameters()
-    assert p["dead_band"]["width_rad"]["value"] == pytest.approx(width, rel=0.03)
+    p = ex.final.parameters()  # measured, dead-band first / cubic first: width 0.55 % / 2.5 %, k3 1.9 % / 0.18 %
+    assert p["dead_band"]["width_rad"]["value"] == pytest.approx(width, rel=0.075)
     assert p["cubic_stiffening"]["k3_Nm_per_rad3"]["value"] == pytest.approx(k3, rel=0.05)
 
 

@@ -28,12 +28,13 @@ def test_explain_bench_file_writes_report_json_and_calibration(tmp_path, spring_
     check = report["declared"][0]
     assert check["name"] == "stiffness_scale" and check["supported"] and "differs from the declared k" in check["text"]
     p = check["fitted"]["scale"]
-    assert p["value"] == pytest.approx(0.75, rel=0.02) and p["unit"] == "1" and p["uncertainty"] > 0
-    assert report["final"]["errors"]["held_out"]["rmse"] < report["plain"]["errors"]["held_out"]["rmse"] / 10
+    # measured: the scale 5.5e-5 off, the held-out RMSE 0.028 times the declared model's
+    assert p["value"] == pytest.approx(0.75, rel=2e-4) and p["unit"] == "1" and p["uncertainty"] > 0
+    assert report["final"]["errors"]["held_out"]["rmse"] < 0.085 * report["plain"]["errors"]["held_out"]["rmse"]
     assert "autocorrelation" in report["residual_tests"]
     cal = json.loads((tmp_path / "out" / "bench_calibration.json").read_text())
-    assert cal["stiffness_scale"] == pytest.approx(0.75, rel=0.02)
-    assert cal["k_fitted_Nm_per_rad"] == pytest.approx(0.75 * 9.106, rel=0.02)
+    assert cal["stiffness_scale"] == pytest.approx(0.75, rel=2e-4)
+    assert cal["k_fitted_Nm_per_rad"] == pytest.approx(0.75 * 9.106, rel=2e-4)
     html = (tmp_path / "out" / "bench.html").read_text()
     assert "data:image/png;base64," in html and (tmp_path / "out" / "bench_loop.png").exists()
 
@@ -58,9 +59,10 @@ def test_thesis_worked_example(tmp_path, spring_file):
     assert res.exit_code == 0, res.output
     cal = json.loads((tmp_path / "thesis_calibration.json").read_text())
     assert set(cal["effects_found"]) == {"stiffness_scale", "dead_band"}
-    assert cal["stiffness_scale"] == pytest.approx(K_MEASURED_NM_PER_RAD / K_FEA_NM_PER_RAD, rel=0.01)
-    assert cal["parameters"]["dead_band"]["width_rad"]["value"] == pytest.approx(0.03, rel=0.02)
-    assert cal["held_out_rmse_after"] < cal["held_out_rmse_before"] / 100
+    # measured: the scale 3.8e-4 off, the dead-band 0.89 %, the held-out RMSE 1.1e-4 times the FEA k's
+    assert cal["stiffness_scale"] == pytest.approx(K_MEASURED_NM_PER_RAD / K_FEA_NM_PER_RAD, rel=1.2e-3)
+    assert cal["parameters"]["dead_band"]["width_rad"]["value"] == pytest.approx(0.03, rel=0.027)
+    assert cal["held_out_rmse_after"] < 3.5e-4 * cal["held_out_rmse_before"]
     # the scale is relative to the thesis FEA's material (generic TPU), so the sweep takes the fitted modulus
     from seadesign.cli.sweep_cmds import apply_calibration
     from seadesign.design.materials import load_material
@@ -68,7 +70,7 @@ def test_thesis_worked_example(tmp_path, spring_file):
 
     study, _ = apply_calibration(load_study("wolfgang_knee"), tmp_path / "thesis_calibration.json")
     e_thesis = load_material("generic_tpu").youngs_modulus_Pa
-    assert study.material.youngs_modulus_Pa == pytest.approx(e_thesis * K_MEASURED_NM_PER_RAD / K_FEA_NM_PER_RAD, rel=0.01)
+    assert study.material.youngs_modulus_Pa == pytest.approx(e_thesis * K_MEASURED_NM_PER_RAD / K_FEA_NM_PER_RAD, rel=1.2e-3)
 
 
 def test_outputs_go_under_exports_by_default(tmp_path, monkeypatch, spring_file, spring_dict):

@@ -37,12 +37,13 @@ def test_a_schema_2_spring_json_with_the_curve_loads_and_is_the_models_spring(tm
 def test_curve_is_the_spring_and_explains_the_softening(spring_dict, softening_knee):
     linear = explain(robot_loop_data(softening_knee, spring_dict), [], max_steps=1)
     assert linear.found == ["cubic_stiffening"], linear.verdict()
-    assert linear.final.parameters()["cubic_stiffening"]["k3_Nm_per_rad3"]["value"] == pytest.approx(K3, rel=0.05)
+    assert linear.final.parameters()["cubic_stiffening"]["k3_Nm_per_rad3"]["value"] == pytest.approx(K3, rel=0.05)  # [0.021]
     with_curve = explain(robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.17)}), [], max_steps=1)
     assert with_curve.found == [], with_curve.verdict()
-    # the curve (7 PCHIP points) predicts as well as the fitted cubic, from the start
-    assert with_curve.plain.errors["held_out"]["rmse"] < 1.05 * linear.final.errors["held_out"]["rmse"]
-    assert with_curve.final.parameters()["stiffness_scale"]["scale"]["value"] == pytest.approx(1.0, abs=0.01)
+    # the curve (7 PCHIP points) predicts as well as the fitted cubic, from the start (measured 0.05 % worse), and its
+    # scale is 1 (measured 1.0064)
+    assert with_curve.plain.errors["held_out"]["rmse"] < 1.002 * linear.final.errors["held_out"]["rmse"]
+    assert with_curve.final.parameters()["stiffness_scale"]["scale"]["value"] == pytest.approx(1.0, abs=0.02)
 
 
 def test_data_past_the_curve_is_refused_not_extrapolated(spring_dict, softening_knee):

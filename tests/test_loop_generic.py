@@ -21,8 +21,8 @@ def test_gravity_on_a_generic_table():
     ex = explain(LoopData(measured, {"time": t, "angle": angle}, predicted=predicted, measured_unit="Nm"), max_steps=2)
     assert ex.found == ["gravity"], ex.verdict()
     p = ex.final.parameters()["gravity"]
-    assert p["amplitude_Nm"]["value"] == pytest.approx(amplitude, rel=0.02)
-    assert p["angle_offset_rad"]["value"] == pytest.approx(offset, abs=0.02)
+    assert p["amplitude_Nm"]["value"] == pytest.approx(amplitude, rel=0.005)  # [0.0014]
+    assert p["angle_offset_rad"]["value"] == pytest.approx(offset, abs=0.0015)  # [0.00045]
     assert GravityLoad.key == "gravity"
 
 
@@ -39,11 +39,14 @@ def test_linear_axis_friction_in_its_own_units_and_the_estimator_api():
     ex = explain(data, max_steps=3)
     assert sorted(ex.found) == ["friction", "sensor_offset"], ex.verdict()
     p = ex.final.parameters()
-    assert p["friction"]["coulomb_Nm"]["value"] == pytest.approx(3.0, rel=0.02)
-    assert p["friction"]["viscous_Nm_s_per_rad"]["value"] == pytest.approx(12.0, rel=0.02)
-    assert p["friction"]["coulomb_Nm"]["unit"] == "N" and p["sensor_offset"]["offset_rad"]["value"] == pytest.approx(1.5, rel=0.02)
+    # measured relative errors in brackets
+    assert p["friction"]["coulomb_Nm"]["value"] == pytest.approx(3.0, rel=0.0017)  # [0.00055]
+    assert p["friction"]["viscous_Nm_s_per_rad"]["value"] == pytest.approx(12.0, rel=0.005)  # [0.0016]
+    assert p["friction"]["coulomb_Nm"]["unit"] == "N"
+    assert p["sensor_offset"]["offset_rad"]["value"] == pytest.approx(1.5, rel=0.0012)  # [0.00039]
     model = EffectModel([Term("stiffness_scale", StiffnessScale(), declared=True), Term("friction", Friction()),
                          Term("sensor_offset", SensorOffset())]).fit(data, ex.held)
-    assert model.parameters()["friction"]["coulomb_Nm"]["value"] == pytest.approx(3.0, rel=0.02)
-    assert model.score(data, ex.held) == pytest.approx(ex.final.errors["held_out"]["rmse"], rel=1e-3)
-    np.testing.assert_allclose(model.predict(data), ex.final.prediction, atol=1e-3)
+    assert model.parameters()["friction"]["coulomb_Nm"]["value"] == pytest.approx(3.0, rel=0.0017)  # [0.00055]
+    # the same fit from other start values: measured 2.3e-7 (score) and 1.7e-6 N (prediction) apart
+    assert model.score(data, ex.held) == pytest.approx(ex.final.errors["held_out"]["rmse"], rel=1e-6)
+    np.testing.assert_allclose(model.predict(data), ex.final.prediction, rtol=0, atol=5e-6)

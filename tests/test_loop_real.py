@@ -2,10 +2,11 @@
 
 Each row: `seadesign explain FILE --spring spring_measured.json --knee l|r` (the thesis's measured spring,
 k = 9.106 Nm/rad; the default declared chain: backlash and gear friction; the data module's cleaning): the
-effects named in order, the declared effects the data does not support, and the held-out RMSE before (the
-declared model as given) and after, to 1 % (the engine is deterministic; the margin is for floating point
-across machines). When the code changes an answer this test fails, and the README is updated on purpose: the
-rows are also checked against the README's table.
+effects named in order, the declared effects the data does not support, the ambiguities reported (winner,
+equally good alternative; the README's remarks under the table), and the held-out RMSE before (the declared
+model as given) and after, to 1 % (the engine is deterministic: the stored four digits are within 0.03 % of the
+values computed here; the margin is for floating point across machines, where the optimiser's path may differ). When the code changes an answer this test fails, and the README is updated on purpose: the rows are
+also checked against the README's table.
 """
 
 from __future__ import annotations
@@ -24,14 +25,18 @@ README = Path(__file__).resolve().parents[1] / "README.md"
 # (file, knee): (named effects in order, unsupported declared effects, held-out RMSE before, after (rad))
 ROWS = {
     ("free_dtest_part1", "l"): (["stiffness_scale", "sensor_drift"], ["backlash", "gear_friction"], 0.1119, 0.08433),
-    ("free_dtest_part1", "r"): (["stiffness_scale", "sensor_delay", "hysteresis"], ["backlash"], 0.1601, 0.07468),
-    ("ground_dtest_part1", "l"): (["sensor_offset", "sensor_step", "sensor_step_2", "hysteresis"], ["backlash"],
-                                  1.483, 0.1003),
-    ("ground_dtest_part1", "r"): (["stiffness_scale", "sensor_offset", "hysteresis", "sensor_step", "sensor_step_2"],
-                                  ["backlash", "gear_friction"], 1.093, 0.1311),
+    ("free_dtest_part1", "r"): (["stiffness_scale", "sensor_delay", "hysteresis", "sensor_offset"], ["backlash"],
+                                0.1601, 0.06850),
+    ("ground_dtest_part1", "l"): (["stiffness_scale", "sensor_offset", "sensor_step", "sensor_step_2", "sensor_delay"],
+                                  ["backlash", "gear_friction"], 1.483, 0.1044),
+    ("ground_dtest_part1", "r"): (["stiffness_scale", "sensor_offset", "hysteresis"], ["backlash", "gear_friction"],
+                                  1.093, 0.1622),
     ("d1free", "l"): (["stiffness_scale"], ["backlash", "gear_friction"], 0.01644, 0.005232),
     ("d1free", "r"): (["stiffness_scale"], ["backlash", "gear_friction"], 0.04526, 0.003184),
 }
+# (file, knee): the ambiguities reported, as (winner, alternative), the README's remarks under the table: the left
+# knee's drift on free_dtest_part1 is an ambiguity with a step; no other row reports one
+AMBIGUITIES = {("free_dtest_part1", "l"): [("sensor_drift", "sensor_step")]}
 
 
 def readme_row(name: str, knee: str) -> str:
@@ -50,6 +55,7 @@ def test_real_recording_findings_are_the_readmes(spring_dict, name, knee):
     found, unsupported, before, after = ROWS[(name, knee)]
     assert ex.found == found, ex.verdict()
     assert ex.unsupported == unsupported
+    assert ex.ambiguities == AMBIGUITIES.get((name, knee), []), ex.verdict()
     assert ex.plain.errors["held_out"]["rmse"] == pytest.approx(before, rel=0.01)
     assert ex.final.errors["held_out"]["rmse"] == pytest.approx(after, rel=0.01)
     assert ex.final.converged

@@ -6,6 +6,12 @@ draws; the first by default, the others with the slow tests), explains the Hall 
 (the spring's k, refitted) and checks that exactly that effect is named and its parameter (library name and
 unit) recovered within the stated relative tolerance. The goal cases with the declared chain are in
 `test_loop_goal.py`.
+
+Detectability at these settings (seed 20, measured): a Dahl loop (sigma 50 Nm/rad) is named from tau_h = 0.02 Nm
+(held-out RMSE 16 % lower) and not at 0.01 Nm. A Maxwell arm (tr 0.2 s) below about 5 Nm/rad is an ambiguity
+with a Dahl loop: the motion is one 0.8 s cycle, where a rate-dependent and a rate-independent loop look alike
+(held-out RMSE 1.7 % apart at 3 Nm/rad, 2.8 % at 4 Nm/rad, both within the 3 % ambiguity band; 4.2 % at 5 and
+6.6 % at 8 Nm/rad, named); the range drawn is 6-12 Nm/rad.
 """
 
 from __future__ import annotations
@@ -27,6 +33,8 @@ CASES = {
     "stiffness_scale": ("scale", (0.6, 0.85), {}, 0.01, 60.0),  # [0.0037]
     "cubic_stiffening": ("k3_Nm_per_rad3", (150.0, 300.0), {}, 0.15, 60.0),  # [0.063]
     "effort_lag": ("time_constant_s", (0.02, 0.08), {}, 0.2, 60.0),  # [0.075]
+    "hysteresis": ("torque_Nm", (0.05, 0.15), {"stiffness_Nm_per_rad": 50.0}, 0.025, 60.0),  # [0.0086]
+    "viscoelastic": ("maxwell_stiffness_Nm_per_rad", (6.0, 12.0), {"relaxation_time_s": 0.2}, 0.03, 60.0),  # [0.0098]
     "thermal_softening": ("softening_per_J", (0.012, 0.016), {"cooling_time_s": 300.0}, 0.3, 120.0),  # [0.128]
     "sensor_offset": ("offset_rad", (0.01, 0.03), {}, 0.02, 60.0),  # [0.0064]
     "sensor_drift": ("rate_rad_per_s", (3e-4, 5e-4), {}, 0.05, 60.0),  # [0.0155]
@@ -59,7 +67,8 @@ def test_robot_effect_named_alone_and_recovered(spring_dict, key, draw_index):
     got = ex.final.parameters()[key][CASES[key][0]]["value"]
     assert got == pytest.approx(value, rel=CASES[key][3])
     if key == "sensor_step":
-        assert ex.final.parameters()[key]["time_s"]["value"] == pytest.approx(effects[key]["time_s"], abs=0.011)
+        # the instant is the jump's sample (measured: exactly, every draw)
+        assert ex.final.parameters()[key]["time_s"]["value"] == pytest.approx(effects[key]["time_s"], abs=1e-9)
 
 
 def test_step_plus_drift_and_backlash_plus_friction(spring_dict):
@@ -68,17 +77,17 @@ def test_step_plus_drift_and_backlash_plus_friction(spring_dict):
     df = robot({"sensor_step": {"size_rad": 0.06, "time_s": 37.0}, "sensor_drift": {"rate_rad_per_s": 4e-4}}, seed=31)
     ex = explain(robot_loop_data(df, spring_dict), [], max_steps=3)
     assert sorted(ex.found) == ["sensor_drift", "sensor_step"], ex.verdict()
-    p = ex.final.parameters()
-    assert p["sensor_step"]["size_rad"]["value"] == pytest.approx(0.06, rel=0.03)
-    assert p["sensor_step"]["time_s"]["value"] == pytest.approx(37.0, abs=0.011)
+    p = ex.final.parameters()  # measured: size 0.55 % off, the instant exact, the rate 1.5 %
+    assert p["sensor_step"]["size_rad"]["value"] == pytest.approx(0.06, rel=0.017)
+    assert p["sensor_step"]["time_s"]["value"] == pytest.approx(37.0, abs=1e-9)
     assert p["sensor_drift"]["rate_rad_per_s"]["value"] == pytest.approx(4e-4, rel=0.05)
-    # together they bias each other: width 4-11 % high, Coulomb 2-3 % low (seeds 32-34)
+    # together they bias each other: width 8.3 % high, Coulomb 1.8 % low (measured)
     df = robot({"dead_band": {"width_rad": 0.03}, "friction": {"coulomb_Nm": 0.3}}, seed=32)
     ex = explain(robot_loop_data(df, spring_dict), [], max_steps=3)
     assert sorted(ex.found) == ["dead_band", "friction"], ex.verdict()
     p = ex.final.parameters()
-    assert p["dead_band"]["width_rad"]["value"] == pytest.approx(0.03, rel=0.3)
-    assert p["friction"]["coulomb_Nm"]["value"] == pytest.approx(0.3, rel=0.1)
+    assert p["dead_band"]["width_rad"]["value"] == pytest.approx(0.03, rel=0.25)
+    assert p["friction"]["coulomb_Nm"]["value"] == pytest.approx(0.3, rel=0.055)
 
 
 def test_two_steps_are_two_jumps(spring_dict):
@@ -88,7 +97,9 @@ def test_two_steps_are_two_jumps(spring_dict):
     assert ex.found == ["sensor_step", "sensor_step_2"], ex.verdict()
     p = ex.final.parameters()
     jumps = sorted((p[n]["time_s"]["value"], p[n]["size_rad"]["value"]) for n in ex.found)
-    assert jumps[0] == pytest.approx((21.0, 0.08), abs=0.011) and jumps[1] == pytest.approx((44.0, -0.05), abs=0.011)
+    # measured: both instants exact, the sizes 0.34 % and 0.23 % off
+    assert [j[0] for j in jumps] == pytest.approx([21.0, 44.0], abs=1e-9)
+    assert [j[1] for j in jumps] == pytest.approx([0.08, -0.05], rel=0.01)
 
 
 def test_misdeclared_backlash_and_gear_friction_are_unsupported(spring_dict):
@@ -97,4 +108,16 @@ def test_misdeclared_backlash_and_gear_friction_are_unsupported(spring_dict):
     ex = explain(robot_loop_data(df, spring_dict), robot_declared(spring_dict))
     assert ex.found == [] and ex.unsupported == ["backlash", "gear_friction"], ex.verdict()
     assert [t.name for t in ex.final.terms] == ["stiffness_scale"]
-    assert ex.final.errors["held_out"]["rmse"] < 0.2 * ex.plain.errors["held_out"]["rmse"]
+    assert ex.final.errors["held_out"]["rmse"] < 0.12 * ex.plain.errors["held_out"]["rmse"]  # measured 0.101
+
+
+def test_a_small_maxwell_arm_is_an_ambiguity_with_a_dahl_loop(spring_dict):
+    """Below the detectability floor (module docstring) a Maxwell arm (3 Nm/rad, 0.2 s) and a Dahl loop fit the
+    one-cycle motion equally well (held-out RMSE 1.7 % apart) and add nothing to each other: one ambiguity, with
+    both fits; the arm's stiffness is still recovered (measured 1.4 % off)."""
+    df = robot({"viscoelastic": {"maxwell_stiffness_Nm_per_rad": 3.0, "relaxation_time_s": 0.2}}, seed=20)
+    ex = explain(robot_loop_data(df, spring_dict), [], max_steps=2)
+    assert ex.ambiguities == [("viscoelastic", "hysteresis")], ex.verdict()
+    assert "cannot tell them apart" in ex.verdict()
+    arm = ex.final.parameters()["viscoelastic"]
+    assert arm["maxwell_stiffness_Nm_per_rad"]["value"] == pytest.approx(3.0, rel=0.04)

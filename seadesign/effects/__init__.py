@@ -10,7 +10,7 @@ used two ways:
 
 What a fitter needs besides: `search(scales)` (bounds and start points that depend on the data,
 `Scales`), `log_params` (positive scale parameters searched in log space), `evaluate` (apply with
-unchecked trial values), and the inverse pieces of the compliance direction (`solve_cubic`,
+unchecked trial values), and the inverse pieces of the compliance direction (`solve_cubic`, `dahl_in_series`,
 `sls_deflection`, `softening_marched`, `DeadBand.free_travel`, `EffortLag.torque_from_effort`,
 `SpringCurve.rotation`).
 

@@ -4,7 +4,7 @@ Order in a chain: dead zones act on `deflection` first, then the spring (`Linear
 large-deflection `SpringCurve`, see `curve.py`) turns it into `torque`, then the torque effects add
 or scale. Each effect's whole-array model is vectorised (`apply`); a fitter that predicts the
 deflection from a torque (the compliance direction) uses the inverse pieces defined here:
-`solve_cubic`, `sls_deflection`, `softening_marched`, `DeadBand.free_travel`.
+`solve_cubic`, `dahl_in_series`, `sls_deflection`, `softening_marched`, `DeadBand.free_travel`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 from scipy.signal import lfilter, lfilter_zi
-from scipy.special import erf
+from scipy.special import erf, wrightomega
 
 from seadesign.constants import THESIS_K_MEASURED_NM_PER_RAD
 from seadesign.effects.base import Effect, Param, Scales, Search, lowpass, rows, time_steps
@@ -138,6 +138,37 @@ def dahl(d: np.ndarray, torque: float, stiffness: float, block: int = 16) -> np.
         into.append(carry)
         carry = end + carry * fade
     return (local + np.asarray(into)[:, None] * np.exp(-v)).ravel()[:n]
+
+
+def dahl_in_series(x: np.ndarray, torque: float, stiffness: float, k: float) -> np.ndarray:
+    """Dahl hysteresis torque z (Nm) of a loop in parallel with a linear spring k (Nm/rad) when the pair carries
+    k x (x in rad, a 1-D record): k d + z(d) = k x, z the Dahl torque of the deflection d = x - z / k.
+
+    Where x moves one way (sign s), dz/dx = k sigma w / (k + sigma w) with w = 1 - s z / tau_h, so y = (sigma / k) w
+    keeps y + ln y + sigma s x / tau_h constant: y follows from its value where the stretch starts by the Wright
+    omega function (the y solving y + ln y = c), and w turns into 2 - w at a reversal (z is continuous). For
+    sigma << k this is `dahl` of x; here the loop may be stiffer than the spring (it then holds the deflection
+    still after a reversal until it slips).
+    """
+    r = stiffness / k
+    step = np.diff(x, prepend=x[0])
+    s = np.sign(step)
+    moving = np.flatnonzero(s)
+    if moving.size == 0:
+        return np.zeros_like(x)
+    s[: moving[0]] = s[moving[0]]  # a sample that does not move keeps the direction it came from
+    s = s[np.maximum.accumulate(np.where(s != 0, np.arange(s.size), 0))]
+    spent = np.cumsum(np.abs(step)) * (stiffness / torque)  # running sum of sigma |dx| / tau_h
+    starts = np.flatnonzero(np.diff(s, prepend=0.0))
+    ends = np.append(starts[1:], x.size) - 1
+    before = np.where(starts > 0, spent[starts - 1], 0.0)
+    z, offsets = 0.0, []  # y + ln y = offset - spent along each stretch
+    for sign, b0, end in zip(s[starts].tolist(), before.tolist(), spent[ends].tolist()):
+        y0 = r * (1.0 - sign * z / torque)
+        offsets.append((y0 + math.log(y0) if y0 > 0 else -math.inf) + b0)
+        z = sign * torque * (1.0 - float(wrightomega(offsets[-1] - end)) / r)
+    level = np.repeat(offsets, ends - starts + 1) - spent
+    return s * torque * (1.0 - wrightomega(level) / r)
 
 
 class DahlHysteresis(Effect):

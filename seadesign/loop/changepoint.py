@@ -24,10 +24,11 @@ def split_gains(x: np.ndarray) -> np.ndarray:
     return i * (n - i) / n * mean_gap ** 2
 
 
-def best_split(x: np.ndarray, min_size: int, exclude: Sequence[int] = ()) -> int | None:
+def best_split(x: np.ndarray, min_size: int, exclude: Sequence[int] = (), interior: bool = False) -> int | None:
     """Index of the largest mean shift of x within the segment between the excluded indices that holds it,
     each side at least `min_size` samples from a segment end (so a shift at the record's ends, an offset,
-    is not a step); None when no segment is long enough."""
+    is not a step); None when no segment is long enough. `interior`: a segment whose largest shift is at the
+    edge of its window (`min_size` from an end) gives none, since the shift may lie beyond the window."""
     bounds = sorted({0, x.size, *exclude})
     best, where = 0.0, None
     for a, b in zip(bounds[:-1], bounds[1:]):
@@ -35,6 +36,8 @@ def best_split(x: np.ndarray, min_size: int, exclude: Sequence[int] = ()) -> int
             continue
         gains = split_gains(x[a:b])[min_size - 1: b - a - min_size]
         j = int(np.argmax(gains))
+        if interior and j in (0, gains.size - 1):
+            continue
         if gains[j] > best:
             best, where = float(gains[j]), a + min_size + j
     return where

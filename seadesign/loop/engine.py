@@ -13,7 +13,9 @@ what was declared.
    wins only when no accepted fit lies inside its bounds. When the runner-up is as good (held-out
    RMSE within `ambiguity`, 3 %) and the two together do not beat the winner by `min_gain`, the data
    cannot tell them apart: the step is reported as an ambiguity with both fits, not a single name.
-   A sensor step is proposed at the instant change-point detection finds in the current residual.
+   A sensor step is proposed at the instant change-point detection finds in the current residual, searched
+   between 10 % and 90 % of the record (none when the largest jump is at that limit), then found again in the
+   residual of its own fit without it, where the current model no longer bends around the jump, until it stays.
 4. Declared effects are tested: one that can be dropped without raising the held-out RMSE by
    `min_gain` (or the BIC by `min_bic_drop`) is unsupported and dropped; the stiffness scale differs
    from the declared k (and is named) only when holding it at 1 fails the same test.
@@ -150,12 +152,42 @@ def _term(key: str, data: LoopData, current: Fit) -> Term | None:
     if key != "sensor_step":
         return Term(key, LIBRARY[key]())
     taken = [current.values[t.name]["time_s"] for t in current.terms if t.key == "sensor_step"]
-    index = best_split(data.measured - current.prediction, min_size=max(10, data.n // 10),  # ends: an offset
-                       exclude=[int(np.searchsorted(data.time - data.time[0], s)) for s in taken])
+    index = _jump(data, data.measured - current.prediction, taken)
     if index is None:
         return None
     name = "sensor_step" if not taken else f"sensor_step_{len(taken) + 1}"
+    return _step(data, name, index)
+
+
+def _jump(data: LoopData, residual: np.ndarray, taken: list[float]) -> int | None:
+    """Index where `residual` jumps, at least a tenth of the record from either end and from the steps `taken`
+    (their instants, s); None when the largest jump is at that limit (it may lie beyond: nearer an end a jump
+    is, over most of the record, an offset)."""
+    return best_split(residual, min_size=max(10, data.n // 10), interior=True,
+                      exclude=[int(np.searchsorted(data.time - data.time[0], s)) for s in taken])
+
+
+def _step(data: LoopData, name: str, index: int) -> Term:
     return Term(name, SensorStep(name, time_s=float(data.time[index] - data.time[0])))
+
+
+def _relocated(data: LoopData, held: np.ndarray, current: Fit, term: Term, f: Fit,
+               fixed: dict) -> tuple[Term, Fit] | None:
+    """A candidate sensor step's instant found again in the residual of its fit `f` without the step, and refitted,
+    until it stays (at most three times): the current model, fitted without the jump, has bent around it, and
+    its residual can put the jump samples away. None when the jump is no longer inside the search window."""
+    taken = [current.values[t.name]["time_s"] for t in current.terms if t.key == "sensor_step"]
+    for _ in range(3):
+        without = evaluate(data, current.terms, f.values, held)
+        index = _jump(data, data.measured - without.prediction, taken)
+        if index is None:
+            return None
+        moved = _step(data, term.name, index)
+        if moved.effect.values["time_s"] == term.effect.values["time_s"]:
+            break
+        term = moved
+        f = _fit(data, current.terms + [term], held, current.values, fixed=fixed)
+    return term, f
 
 
 def _pinned(f: Fit, name: str) -> bool:
@@ -219,9 +251,15 @@ def _trace(data: LoopData, held: np.ndarray, current: Fit, pool: list[str], gate
         if key in {t.key for t in current.terms} and key != "sensor_step":
             continue
         term = _term(key, data, current)
-        if term is not None:
-            f = _fit(data, current.terms + [term], held, current.values, fixed=held_values)
-            screened.append((term, f))
+        if term is None:
+            continue
+        f = _fit(data, current.terms + [term], held, current.values, fixed=held_values)
+        if term.key == "sensor_step":
+            located = _relocated(data, held, current, term, f, held_values)
+            if located is None:
+                continue
+            term, f = located
+        screened.append((term, f))
     screened.sort(key=lambda tf: tf[1].errors["held_out"]["rmse"])
     trace = []
     for i, (term, f) in enumerate(screened):

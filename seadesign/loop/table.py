@@ -123,9 +123,14 @@ class LoopData:
             self.__dict__[key] = self.smoothed(self.signals[role])
         return self.__dict__[key]
 
+    @property
+    def window(self) -> int:
+        """Samples in the smoother's window (`smooth`, ~0.1 s)."""
+        return max(5, int(round(0.1 / self.dt)) | 1)
+
     def smoothed(self, x: np.ndarray) -> np.ndarray:
         """Any array over this record's samples through the same smoother (`smooth`, window from `dt`)."""
-        window = max(5, int(round(0.1 / self.dt)) | 1)
+        window = self.window
         return x if window >= x.size else convolve1d(np.asarray(x, dtype=float), _savgol(window), mode="nearest")
 
     def noise(self, role: str) -> float:

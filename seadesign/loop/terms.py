@@ -10,7 +10,7 @@ effect's, with the effect's names and units. `PLACES` says where an effect acts:
 - `deflection`: dead-band or backlash (`DeadBand`; in the compliance direction its free travel);
 - `spring`: the spring law: `stiffness_scale` (the declared k, always refitted), cubic stiffening,
   hysteresis, viscoelasticity (torque terms; in the compliance direction inverted: a Newton solve of
-  the cubic, the inverse of the standard-linear-solid filter, the Dahl term over k), thermal and
+  the cubic, the inverse of the standard-linear-solid filter, the Dahl loop sharing the torque with k), thermal and
   temperature softening (factors; thermal in the compliance direction marched in time);
 - `load` (stiffness direction): friction against `velocity`, gravity against `angle`.
 
@@ -30,7 +30,7 @@ import numpy as np
 from scipy.ndimage import shift
 
 from seadesign.effects import LIBRARY, Effect
-from seadesign.effects.spring import dahl, sls_deflection, softening_marched, solve_cubic
+from seadesign.effects.spring import dahl, dahl_in_series, sls_deflection, softening_marched, solve_cubic
 from seadesign.loop.table import LoopData
 
 PLACES: dict[str, str] = {
@@ -219,7 +219,7 @@ def _deflection(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray
         if t.key == "cubic_stiffening":  # k d + k3 d^3 = k x
             x = solve_cubic(x, p["k3_Nm_per_rad3"] / k)
         elif t.key == "hysteresis":
-            x = x - dahl(xs, p["torque_Nm"], p["stiffness_Nm_per_rad"]) / k
+            x = x - dahl_in_series(xs, p["torque_Nm"], p["stiffness_Nm_per_rad"], k) / k
         elif t.key == "viscoelastic":
             x = x + sls_deflection(xs, data.dt, p["maxwell_stiffness_Nm_per_rad"] / k, p["relaxation_time_s"]) - xs
         elif t.key == "thermal_softening":
