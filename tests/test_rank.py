@@ -104,12 +104,16 @@ def test_weights_move_the_choice(study):
     assert t.loc[c.index, "candidate"] == "A"  # softest feasible spring
 
 
-def test_a_pool_that_stops_before_stall_is_ordered_by_the_torque_carried(study):
-    rows = [("P", 20.0, 0.2, 5.0), ("Q", 30.0, 0.2, 8.0), ("R", 25.0, 0.2, 7.0)]
+def test_a_pool_that_stops_before_stall_is_ordered_by_the_usable_torque(study):
+    """Usable: the smaller of the stop torque and where the strain passes the allowable. S stops at 9 Nm but
+    passes the allowable at 0.433 / 3 rad x 30 Nm/rad = 4.33 Nm."""
+    rows = [("P", 20.0, 0.2, 5.0), ("Q", 30.0, 0.2, 8.0), ("R", 25.0, 0.2, 7.0), ("S", 30.0, 3.0, 9.0)]
     t, c = rank(_table(study, rows), study)
+    by = t.set_index("candidate")
+    assert by.loc["S", "usable_torque_Nm"] == pytest.approx(4.33) and by.loc["Q", "usable_torque_Nm"] == 8.0
     assert not c.feasible and t.loc[c.index, "candidate"] == "Q"
-    assert t.set_index("candidate").loc[["Q", "R", "P"], "rank"].tolist() == [1, 2, 3]
-    assert t["score"].isna().all() and "carries the most torque" in c.explanation and "8 Nm" in c.explanation
+    assert by.loc[["Q", "R", "P", "S"], "rank"].tolist() == [1, 2, 3, 4]
+    assert t["score"].isna().all() and "most usable torque" in c.explanation and "8 Nm usable" in c.explanation
 
 
 def test_k_range_and_no_feasible_candidate(study):

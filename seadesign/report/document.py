@@ -11,7 +11,7 @@ import pandas as pd
 
 SUMMARY_COLUMNS = [
     "candidate", "status", "mass_g", "k_Nm_per_rad", "k_rel_error", "large_stop_reason", "large_stop_rotation_rad",
-    "large_stop_torque_Nm", "large_strain_limit_torque_Nm", "large_stall_rotation_rad", "large_stall_secant_k_Nm_per_rad",
+    "large_stop_torque_Nm", "large_strain_limit_torque_Nm", "usable_torque_Nm", "large_stall_rotation_rad", "large_stall_secant_k_Nm_per_rad",
     "large_stall_tangent_k_Nm_per_rad", "large_stall_bearing_displacement_mm", "large_stall_peak_strain",
     "large_stall_strain_margin", "large_stall_survives", "large_impact_survives", "standing_deflection_deg",
     "impact_gearbox_torque_Nm", "stall_rotation_rad", "stall_von_mises_max_MPa", "thesis_reaction_N",

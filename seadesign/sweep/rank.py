@@ -36,7 +36,7 @@ from seadesign.design.study import Study
 
 ACCURACY = "large_stall_bearing_displacement_mm"
 PROTECTION = "impact_gearbox_torque_Nm"
-CARRIED = "large_stop_torque_Nm"  # the order of a pool that no objective can rank: the most torque carried first
+USABLE = "usable_torque_Nm"  # the order of a pool that no objective can rank: the most usable torque first
 
 
 @dataclass(frozen=True)
@@ -66,7 +66,8 @@ def strike_torque(rotation_rad, torque_Nm, energy_J: float) -> float:
 
 
 def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
-    """Standing deflection, impact energy and gearbox strike torque read from each curve, thesis numbers."""
+    """Standing deflection, impact energy and gearbox strike torque read from each curve, the usable torque
+    (the smaller of where the path stops and where the peak strain passes the allowable), thesis numbers."""
     rk, robot = study.ranking, study.robot
     t = table.copy()
     energy = 0.5 * rk.knee_inertia_kg_m2 * (rk.impact_speed_m_per_s / robot.lower_leg_m) ** 2
@@ -75,6 +76,8 @@ def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
     t["standing_deflection_deg"] = np.degrees(t["large_standing_rotation_rad"]) if "large_standing_rotation_rad" in t \
         else np.nan
     t["strike_energy_J"] = energy
+    if "large_stop_torque_Nm" in t:
+        t[USABLE] = t[["large_stop_torque_Nm", "large_strain_limit_torque_Nm"]].min(axis=1, skipna=True)
     t[PROTECTION] = [strike_torque(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], energy) if ok else np.nan
                      for ok, (_, r) in zip(solved, t.iterrows())]
     thesis = [_thesis_result(study, row) for _, row in t.iterrows()]
@@ -137,7 +140,8 @@ def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
     The pool is the feasible candidates; when none is feasible, the solved candidates that fail the
     fewest constraints (the choice is then marked infeasible and says what it violates). A pool in which
     some candidate has no objective (its curve stops before the stall torque or before storing the
-    strike's energy) cannot be scored: it is ordered by the torque each carries before its path stops.
+    strike's energy) cannot be scored: it is ordered by the usable torque, the most a candidate carries
+    before its path stops and within the allowable strain.
     """
     t = constraint_columns(physical_columns(table, study), study)
     rk = study.ranking
@@ -162,7 +166,7 @@ def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
         t.loc[pool, "score"] = (rk.weight_accuracy * acc + rk.weight_protection * prot) / w
         order = t[pool].sort_values(["score", ACCURACY], ascending=[False, True]).index
     else:
-        order = t[pool].sort_values([CARRIED, "k_Nm_per_rad"], ascending=[False, True]).index
+        order = t[pool].sort_values([USABLE, "k_Nm_per_rad"], ascending=[False, True]).index
     t.loc[order, "rank"] = np.arange(1, len(order) + 1)
     best = int(order[0])
     second = int(order[1]) if len(order) > 1 else None
@@ -171,16 +175,21 @@ def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
 
 
 def _explain_carried(t: pd.DataFrame, best: int, second: int | None) -> str:
-    """Why a pool without objectives chose `best`: the most torque carried before the path stops."""
+    """Why a pool without objectives chose `best`: the most usable torque."""
     b = t.loc[best]
+
+    def usable(r: pd.Series) -> str:
+        limit = r["large_strain_limit_torque_Nm"]
+        strain = f", the allowable strain passed at {limit:.3g} Nm" if np.isfinite(limit) else ""
+        return (f"{r[USABLE]:.3g} Nm usable (its path stops at {r['large_stop_torque_Nm']:.3g} Nm, "
+                f"{r['large_stop_rotation_rad']:.3g} rad: {r['large_stop_reason']}{strain})")
+
     text = (f"No candidate meets every hard constraint, and the ones failing the fewest "
             f"({int(b['n_failed_constraints'])}: {b['failed_constraints']}) cannot all be scored, so the choice is "
-            f"the one that carries the most torque before its path stops: {b['candidate']}, "
-            f"{b[CARRIED]:.3g} Nm at {b['large_stop_rotation_rad']:.3g} rad ({b['large_stop_reason']}; small-load "
-            f"k {b['k_Nm_per_rad']:.3g} Nm/rad).")
+            f"the one with the most usable torque, the most it carries before its path stops and within the "
+            f"allowable strain: {b['candidate']}, {usable(b)}; small-load k {b['k_Nm_per_rad']:.3g} Nm/rad.")
     if second is not None:
-        r = t.loc[second]
-        text += f" Next: {r['candidate']}, {r[CARRIED]:.3g} Nm ({r['large_stop_reason']})."
+        text += f" Next: {t.loc[second, 'candidate']}, {usable(t.loc[second])}."
     return text
 
 
