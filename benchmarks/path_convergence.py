@@ -5,7 +5,8 @@ Usage: python benchmarks/path_convergence.py [--study wolfgang_knee] [--candidat
 Prints, per candidate and mesh (a coarsening of the study's mesh: 1 is the result mesh, 2 the sweep's
 path mesh), the degrees of freedom, the torque at each listed rotation (Nm), where and why the path stops
 (rad, Nm), the torque where the peak strain passes the allowable strain, the peak strain at the first listed
-rotation, the time, and each number's difference to the finest mesh's. Contact and strain peaks sit at beam
+rotation, the time, and each number's difference to the coarsest mesh's as each mesh finishes (a
+run stopped early keeps its rows), then the table again against the finest. Contact and strain peaks sit at beam
 roots (fillets), so they converge more slowly than the torque.
 """
 
@@ -51,24 +52,33 @@ def main() -> None:
         candidate, part = check_geometry(st, st.candidate(beam_count=int(n), beam_thickness_mm=float(t)), cache)
         part = part or st.check(candidate)[1]
         m, lc = candidate.material, st.load_cases
+        print(f"\n{candidate.name}: torque (Nm) at {', '.join(f'{r:g}' for r in rotations)} rad; stop; strain limit "
+              f"torque (Nm); peak strain at {rotations[0]:g} rad; in brackets: relative difference to the first "
+              f"(coarsest) mesh, then the table again against the finest", flush=True)
         rows = []
         for c in coarsenings:
             mesh = tetrahedralize(st, candidate, part, cache, c)
             path = rotation_path(mesh, m.law, lc.impact_torque_Nm, PathSettings())
             ld = large_deflection(path, st.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
                                   m.allowable_strain(st.ranking.safety_factor))
-            rows.append((c, ld.dofs, [_number(path.torque_at(r)) for r in rotations], path.stop_reason, ld.stop_rotation_rad,
-                         ld.stop_torque_Nm, ld.strain_limit_torque_Nm, strain_at(path, rotations[0]), path.time_s))
-        print(f"\n{candidate.name}: torque (Nm) at {', '.join(f'{r:g}' for r in rotations)} rad; stop; strain limit "
-              f"torque (Nm); peak strain at {rotations[0]:g} rad; in brackets: relative difference to coarsening "
-              f"{rows[-1][0]:g}")
-        ref = rows[-1]
-        for c, dofs, torques, reason, stop_rad, stop_Nm, limit_Nm, strain, secs in rows:
-            def rel(v, r):
-                return f"{v:.4g} [{(v - r) / r:+.2%}]"
-            print(f"  coarsening {c:<4g} {dofs:>8d} dofs  T " + ", ".join(rel(v, r) for v, r in zip(torques, ref[2]))
-                  + f"  stop {reason} {rel(stop_rad, ref[4])} rad {rel(stop_Nm, ref[5])} Nm  strain limit "
-                  f"{rel(limit_Nm, ref[6])} Nm  strain {rel(strain, ref[7])}  {secs:.0f} s")
+            rows.append((c, ld.dofs, [_number(path.torque_at(r)) for r in rotations], path.stop_reason,
+                         ld.stop_rotation_rad, ld.stop_torque_Nm, ld.strain_limit_torque_Nm,
+                         strain_at(path, rotations[0]), path.time_s))
+            _print_row(rows[-1], rows[0])  # as it comes: a long run leaves its coarse rows
+        print("  against the finest:")
+        for row in rows:
+            _print_row(row, rows[-1])
+
+
+def _print_row(row, ref) -> None:
+    c, dofs, torques, reason, stop_rad, stop_Nm, limit_Nm, strain, secs = row
+
+    def rel(v, r):
+        return f"{v:.4g} [{(v - r) / r:+.2%}]"
+
+    print(f"  coarsening {c:<4g} {dofs:>8d} dofs  T " + ", ".join(rel(v, r) for v, r in zip(torques, ref[2]))
+          + f"  stop {reason} {rel(stop_rad, ref[4])} rad {rel(stop_Nm, ref[5])} Nm  strain limit "
+          f"{rel(limit_Nm, ref[6])} Nm  strain {rel(strain, ref[7])}  {secs:.0f} s", flush=True)
 
 
 if __name__ == "__main__":
