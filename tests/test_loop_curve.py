@@ -25,12 +25,12 @@ def softening_knee():
 
 
 def test_a_schema_2_spring_json_with_the_curve_loads_and_is_the_models_spring(tmp_path, spring_dict):
-    from seadesign.design.spring import load_spring, write_spring
-    from seadesign.effects import SpringCurve
-    from seadesign.loop.sea import model_spring
+    from seadesign.design.spring import load_spring, torque_curve, write_spring
+    from seadesign.effects import SpringCurve, spring_law
 
     path = write_spring({**spring_dict, "schema_version": 2, "torque_curve": curve(0.17)}, tmp_path / "spring.json")
-    spring = model_spring(load_spring(path))
+    loaded = load_spring(path)
+    spring = spring_law(loaded["k_Nm_per_rad"], torque_curve(loaded))
     assert isinstance(spring, SpringCurve) and spring.curve.end_rotation_rad == pytest.approx(0.17)
 
 
