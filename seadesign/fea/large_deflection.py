@@ -95,9 +95,9 @@ def _location(path: TorquePath, element: int) -> PeakLocation:
     return PeakLocation(*map(float, x))
 
 
-def _load_point(path: TorquePath, torque_Nm: float, allowable: float, contact_is_end_stop: bool) -> LoadPoint:
-    theta = np.array([p.rotation_rad for p in path.points])
-    strain = np.array([p.peak_strain for p in path.points])
+def _load_point(path: TorquePath, theta: np.ndarray, strain: np.ndarray, torque_Nm: float, allowable: float,
+                contact_is_end_stop: bool) -> LoadPoint:
+    """The path at one load torque; `theta` and `strain` are its points' rotations (rad) and peak strains."""
     rotation = path.rotation_at(torque_Nm)
     reached = rotation is not None and rotation <= path.stop_rotation_rad
     tangent = math.nan
@@ -150,9 +150,9 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
         peak_strain_at=_location(path, worst_strain.peak_strain_element),
         peak_von_mises_MPa=worst_stress.peak_von_mises_Pa * 1e-6,
         peak_von_mises_at=_location(path, worst_stress.peak_von_mises_element),
-        standing=_load_point(path, standing_torque_Nm, allowable, contact_is_end_stop),
-        stall=_load_point(path, stall_torque_Nm, allowable, contact_is_end_stop),
-        impact=_load_point(path, impact_torque_Nm, allowable, contact_is_end_stop),
+        standing=_load_point(path, theta, strain, standing_torque_Nm, allowable, contact_is_end_stop),
+        stall=_load_point(path, theta, strain, stall_torque_Nm, allowable, contact_is_end_stop),
+        impact=_load_point(path, theta, strain, impact_torque_Nm, allowable, contact_is_end_stop),
         increments=len(pts) - 1,
         newton_iterations=sum(p.iterations for p in pts),
         cut_backs=path.cut_backs,
