@@ -65,8 +65,8 @@ def apply_calibration(study: Study, path: Path) -> tuple[Study, str]:
               help="STL chordal tolerance in mm.")
 def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: str | None, export_all: bool,
           out_dir: Path, calibration: Path | None, cache_dir: Path | None, tolerance_mm: float) -> None:
-    """Run every candidate of STUDY (geometry, validity, mesh, both load cases), rank them and write
-    results.parquet/csv, plots, report.html/md, STL/STEP and spring.json to OUT/<study>/.
+    """Run every candidate of STUDY (geometry, validity, mesh, both linear load cases, the large-deflection
+    torque path), rank them on the paths and write results.parquet/csv, plots, report.html/md, STL/STEP and spring.json to OUT/<study>/.
 
     Ctrl-C or SIGTERM stops it within a second or two, keeping every finished candidate; the same
     command resumes, and unchanged stages come from the cache. Units: lengths mm where named,
