@@ -8,13 +8,18 @@ and the table-6.2 analogue (peak absolute error), plus flags:
 - ``unstable``: the corrector produced a non-finite command, its command left the target by
   more than `UNSTABLE_COMMAND_RAD`, or the Hall reading left +-`UNSTABLE_HALL_RAD` (the run
   stops there); a large but bounded error (e.g. the spring's sag on the ground) is not instability;
-- ``oscillating``: the command's correction (command - target) carries high-frequency chatter:
-  its part above a `CHATTER_WINDOW_S` moving average has an RMS above `CHATTER_RMS_RAD`
-  in some trial (sensor noise passed through gives far less).
+- ``oscillating``: while the target is at rest (the trials' standing phases, from `REST_SETTLE_S`
+  after the trial starts), the command's correction (command - target) carries chatter: its part
+  above a `CHATTER_WINDOW_S` moving average has an RMS above `CHATTER_RMS_RAD` in some trial
+  (sensor noise passed through a PI gives far less). Judged at rest because there a correction
+  has nothing to follow: a feed-forward's command is still, while a loop that oscillates keeps
+  chattering. While walking, a feed-forward's correction carries the gait's own high harmonics
+  (the dynamics it cancels), so chatter there is no sign of oscillation.
 
 The thesis's 0.103 rad "command offset" correction is not applied: the simulator's target is
 the position the knee should reach. Correctors that need IMU or foot-pressure inputs cannot be
-driven (the simulator's observation holds only the knee channels) and are refused.
+driven (the simulator's observation holds only the knee channels) and are refused. A corrector with
+`preview_steps` > 0 also gets the walk engine's next targets and the leg's load share (`Preview`).
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ import pandas as pd
 
 from seadesign.corrector.dataset import KNEES
 from seadesign.corrector.modalities import FIELD_CHANNELS, IMU_CHANNELS, PRESSURE_CHANNELS
+from seadesign.corrector.reference import Preview
 from seadesign.corrector.runtime import Corrector
 from seadesign.errors import ConfigError, SeadesignError
 from seadesign.twin import KneeSession, Trial, thesis_protocol
@@ -36,6 +42,7 @@ UNSTABLE_COMMAND_RAD = 1.5
 UNSTABLE_HALL_RAD = np.pi
 CHATTER_WINDOW_S = 0.1
 CHATTER_RMS_RAD = 0.02
+REST_SETTLE_S = 0.2
 _ABSENT = dict.fromkeys(IMU_CHANNELS + PRESSURE_CHANNELS, float("nan"))
 
 
@@ -76,13 +83,18 @@ def run_closed_loop(corrector: Corrector, spring: dict[str, Any], trials: list[T
         copies.append(c)
     shape = (sim.n_trials, sim.n_steps, 2)
     target, hall, command, effort = (np.full(shape, np.nan) for _ in range(4))
+    ahead = getattr(corrector, "preview_steps", 0)
+    load = sim.stance * float(ground)
     obs, unstable, note = sim.observe(), False, ""
     while obs is not None:
         cmd = np.empty((sim.n_trials, 2))
+        t = obs.step
         for i, c in enumerate(copies):
             for k, knee in enumerate(KNEES):
                 measured = {dst: float(getattr(obs, src)[i, k]) for src, dst in FIELD_CHANNELS.items()}
-                cmd[i, k] = c.command(knee, float(obs.target[i, k]), {**measured, **_ABSENT}, sim.dt)
+                extra = {"preview": Preview(sim.target[i, t + 1: t + 1 + ahead, k], load[i, t: t + 1 + ahead, k])} \
+                    if ahead else {}
+                cmd[i, k] = c.command(knee, float(obs.target[i, k]), {**measured, **_ABSENT}, sim.dt, **extra)
         target[:, obs.step], hall[:, obs.step], command[:, obs.step] = obs.target, obs.hall_pos, cmd
         effort[:, obs.step] = obs.knee_eff
         if not np.isfinite(cmd).all() or np.abs(cmd - obs.target).max() > UNSTABLE_COMMAND_RAD \
@@ -95,25 +107,35 @@ def run_closed_loop(corrector: Corrector, spring: dict[str, Any], trials: list[T
         except ConfigError as exc:
             unstable, note = True, f"simulator refused the command at step {obs.step}: {exc}"
             break
-    chatter = chatter_rms(command, target, rate_hz)
     table = sim.recording(partial=True) if sim.n_logged >= 2 else None
     return ClosedLoopRun(corrector.name, rate_hz, trials, target, hall, command, effort, unstable,
-                         bool(np.nanmax(chatter) > CHATTER_RMS_RAD), note, table)
+                         _nanmax(chatter_rms(command, target, rate_hz)) > CHATTER_RMS_RAD, note, table)
+
+
+def _nanmax(x: np.ndarray) -> float:
+    """Largest finite value, 0 when there is none (a run stopped before any rest)."""
+    return float(np.nanmax(x)) if np.isfinite(x).any() else 0.0
 
 
 def chatter_rms(command: np.ndarray, target: np.ndarray, rate_hz: float) -> np.ndarray:
-    """Per trial and knee (rad): RMS of (command - target) minus its `CHATTER_WINDOW_S` moving average."""
+    """Per trial and knee (rad): RMS of (command - target) minus its `CHATTER_WINDOW_S` moving average,
+    over the samples where the target is at rest (NaN where a trial has none)."""
     corr = command - target
     n = max(3, int(round(CHATTER_WINDOW_S * rate_hz)) | 1)
     kernel = np.ones(n) / n
+    settle = int(round(REST_SETTLE_S * rate_hz))
     out = np.full(corr.shape[::2], np.nan)
     for i in range(corr.shape[0]):
         for k in range(corr.shape[2]):
-            x = corr[i, :, k]
-            x = x[np.isfinite(x)]
-            if len(x) > n:
-                hf = x[n // 2: len(x) - n // 2] - np.convolve(x, kernel, mode="valid")
-                out[i, k] = float(np.sqrt(np.mean(hf ** 2)))
+            x, tgt = corr[i, :, k], target[i, :, k]
+            m = int(np.isfinite(x).sum())
+            if m <= n:
+                continue
+            hf = x[n // 2: m - n // 2] - np.convolve(x[:m], kernel, mode="valid")
+            still = np.convolve(np.abs(np.diff(tgt[:m], prepend=tgt[0])) < 1e-9, kernel, mode="valid") > 1 - 1e-9
+            still &= np.arange(n // 2, m - n // 2) >= settle
+            if still.any():
+                out[i, k] = float(np.sqrt(np.mean(hf[still] ** 2)))
     return out
 
 
@@ -133,7 +155,7 @@ def summary_row(run: ClosedLoopRun, setting: str) -> dict[str, Any]:
             "peak_abs_error_rad": float(np.nanmax(err)),
             "left_mean_abs_error_rad": float(np.nanmean(err[..., 0])),
             "right_mean_abs_error_rad": float(np.nanmean(err[..., 1])),
-            "chatter_rms_max_rad": float(np.nanmax(chatter_rms(run.command, run.target, run.rate_hz))),
+            "rest_chatter_rms_max_rad": _nanmax(chatter_rms(run.command, run.target, run.rate_hz)),
             "unstable_flag": run.unstable, "oscillating_flag": run.oscillating, "note": run.note}
 
 

@@ -12,6 +12,9 @@ frame, SI). `reset()` clears internal state between trials.
   through the servo then acts as an undamped integral controller on the Hall error that
   oscillates (seen in the knee simulator). At rest the filter changes nothing.
 - `NetCorrector`: a trained network (NumPy path of an exported bundle).
+- `ReferenceFeedForward`: a network on the reference window only (`reference.py`), plus an optional
+  low-gain PI on the Hall error; it reads the walk engine's preview (`preview_steps` > 0), which the
+  closed loop passes as `preview=`.
 """
 
 from __future__ import annotations
@@ -22,6 +25,8 @@ import numpy as np
 
 from seadesign.corrector.dataset import KNEES, DatasetSpec, FeatureBuilder
 from seadesign.corrector.export import NumpyCorrector
+from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow
+from seadesign.data import KNEE_SIGN_BY_NAME
 from seadesign.design.spring import TorqueCurve
 from seadesign.errors import SeadesignError
 
@@ -108,3 +113,33 @@ class NetCorrector:
         if self.model.siamese:  # x_t: measured state; x_t+1: the target with this step's channels (thesis 6.2.3)
             x = np.concatenate([b.state(), x])
         return b.unmirror(float(self.model(x)))
+
+
+class ReferenceFeedForward:
+    """command = target + network(reference window) + kp e + ki integral(e dt), e = target - hall (flexion).
+
+    The network (NumPy path) maps `reference.reference_features` to the command (rad, flexion); the
+    right knee is mirrored in and out. `kp`, `ki` (1, 1/s): the outer PI, 0 to switch it off.
+    """
+
+    def __init__(self, model: NumpyCorrector, window: ReferenceWindow, k_Nm_per_rad: float, kp: float = 0.0,
+                 ki: float = 0.0, name: str = "reference") -> None:
+        self.model, self.window, self.k, self.kp, self.ki, self.name = model, window, k_Nm_per_rad, kp, ki, name
+        self.preview_steps = window.preview
+        self.reset()
+
+    def reset(self) -> None:
+        self._buffers = {k: ReferenceBuffer(self.window, self.k) for k in KNEES}
+        self._integral = {k: 0.0 for k in KNEES}
+
+    def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float,
+                preview: Preview | None = None) -> float:
+        if preview is None:
+            raise SeadesignError(f"corrector '{self.name}' needs the walk engine's preview of "
+                                 f"{self.preview_steps} steps; drive it through the closed loop")
+        sign = KNEE_SIGN_BY_NAME[knee]
+        target = sign * target_rad
+        x = self._buffers[knee].features(target, sign * np.asarray(preview.target_rad), preview.load_share)
+        e = target - sign * measured["hall_pos_rad"]
+        self._integral[knee] += e * dt_s
+        return sign * (float(self.model(x)) + self.kp * e + self.ki * self._integral[knee])

@@ -74,39 +74,46 @@ def _inputs(ds: CorrectorDataset, siamese: bool) -> np.ndarray:
 
 def fit(ds: CorrectorDataset, split: Split, k_Nm_per_rad: float, config: TrainConfig = TrainConfig()) -> TrainResult:
     """Train `config.model` on split.train, early-stop on split.val; returns the best-validation network."""
-    if len(split.train) == 0 or len(split.val) == 0:
-        raise SeadesignError(f"split '{split.name}' left an empty training or validation set; give more data")
     if config.model == "history" and ds.spec.history == 0:
         raise SeadesignError("model 'history' needs a history window; pass --history N (samples, e.g. 3)")
+    siamese = config.model == "siamese"
+    w = base_weights(config.model, ds.feature_names, k_Nm_per_rad)
+    return fit_arrays(_inputs(ds, siamese), ds.y, split, w, config, d_state=ds.X.shape[1])
+
+
+def fit_arrays(X: np.ndarray, y: np.ndarray, split: Split, base_w: torch.Tensor, config: TrainConfig,
+               d_state: int | None = None) -> TrainResult:
+    """Train a `CorrectorNet` with fixed base weights `base_w` on raw inputs X (N, d) and commands y (N,) rad;
+    rows split.train to fit, split.val to stop early. `d_state`: length of one state vector (Siamese)."""
+    if len(split.train) == 0 or len(split.val) == 0:
+        raise SeadesignError(f"split '{split.name}' left an empty training or validation set; give more data")
     threads_before = torch.get_num_threads()
     torch.set_num_threads(config.threads or min(2, os.cpu_count() or 1))
     try:
-        return _fit(ds, split, k_Nm_per_rad, config)
+        return _fit(X, y, split, base_w, config, d_state or X.shape[1])
     finally:
         torch.set_num_threads(threads_before)
 
 
-def _fit(ds: CorrectorDataset, split: Split, k: float, cfg: TrainConfig) -> TrainResult:
+def _fit(X_np: np.ndarray, y_np: np.ndarray, split: Split, w: torch.Tensor, cfg: TrainConfig, d_state: int) -> TrainResult:
     siamese = cfg.model == "siamese"
     dev = _device(cfg.device)
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed)
 
-    X = torch.as_tensor(_inputs(ds, siamese), dtype=torch.float32)
-    y = torch.as_tensor(ds.y, dtype=torch.float32)
+    X = torch.as_tensor(X_np, dtype=torch.float32)
+    y = torch.as_tensor(y_np, dtype=torch.float32)
     tr, va = torch.as_tensor(split.train), torch.as_tensor(split.val)
     x_mean, x_std = X[tr].mean(0), X[tr].std(0)
     x_std = torch.where(x_std > 1e-8, x_std, torch.ones_like(x_std))
     if siamese:  # one normalisation for x_t and x_t+1: the encoder is shared
-        d = ds.X.shape[1]
-        both = torch.cat([X[tr, :d], X[tr, d:]])
+        both = torch.cat([X[tr, :d_state], X[tr, d_state:]])
         m, s = both.mean(0), both.std(0)
         s = torch.where(s > 1e-8, s, torch.ones_like(s))
         x_mean, x_std = torch.cat([m, m]), torch.cat([s, s])
-    w = base_weights(cfg.model, ds.feature_names, k)
     resid = y - X @ w
     y_mean, y_std = float(resid[tr].mean()), float(resid[tr].std().clamp_min(1e-8))
-    net = CorrectorNet(make_core(cfg.model, ds.X.shape[1], cfg.hidden, cfg.layers), x_mean, x_std, y_mean, y_std, w)
+    net = CorrectorNet(make_core(cfg.model, d_state, cfg.hidden, cfg.layers), x_mean, x_std, y_mean, y_std, w)
     net.to(dev)
 
     Xn = ((X - x_mean) / x_std).to(dev)

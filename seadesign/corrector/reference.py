@@ -1,0 +1,105 @@
+"""Inputs of the feed-forward corrector: a window of the reference trajectory, never a measurement.
+
+At control step t the network sees, in knee flexion (the right knee mirrored, so both knees
+look alike), with `past` and `preview` steps at the control rate:
+
+- `target_rad`: the target at t;
+- `target_rad@t-i` - target(t) for i = past ... 1 and `target_rad@t+i` - target(t) for i = 1 ... preview
+  (the walk engine's trajectory around t, relative to now);
+- `load_share@t+i` for i = -past ... preview: the leg's expected share of the body weight (0 in
+  swing and whenever the robot hangs), from the walk engine's support phase;
+- `k_Nm_per_rad`: the spring's stiffness from spring.json.
+
+Before a trial's start the window holds the first value, after its end the last one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from seadesign.errors import SeadesignError
+
+
+@dataclass(frozen=True)
+class ReferenceWindow:
+    """How much trajectory the network sees: `past` and `preview` steps at the control rate."""
+
+    past: int = 5
+    preview: int = 10
+
+    def __post_init__(self) -> None:
+        if self.past < 0 or self.preview < 0:
+            raise SeadesignError(f"reference window past/preview must be >= 0 steps, got {self.past}/{self.preview}")
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """Step offsets of the window, -past ... preview."""
+        return np.arange(-self.past, self.preview + 1)
+
+    def feature_names(self) -> tuple[str, ...]:
+        """Input names in order."""
+        rel = [f"target_rad@t{o:+d}" for o in self.offsets if o != 0]
+        load = [f"load_share@t{o:+d}" if o else "load_share" for o in self.offsets]
+        return ("target_rad", *rel, *load, "k_Nm_per_rad")
+
+    def to_dict(self) -> dict[str, int]:
+        return {"past": self.past, "preview": self.preview}
+
+
+def _windows(x: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """x (..., n) -> (..., n, len(offsets)): x[t + o], clamped to the ends."""
+    n = x.shape[-1]
+    idx = np.clip(np.arange(n)[:, None] + offsets[None, :], 0, n - 1)
+    return x[..., idx]
+
+
+def reference_features(target_rad: np.ndarray, load_share: np.ndarray, k_Nm_per_rad: float,
+                       window: ReferenceWindow) -> np.ndarray:
+    """Inputs for every step of whole trajectories: target and load share (..., n) in flexion -> (..., n, d)."""
+    off = window.offsets
+    tw, lw = _windows(target_rad, off), _windows(load_share, off)
+    rel = tw[..., off != 0] - target_rad[..., None]
+    k = np.full(target_rad.shape + (1,), float(k_Nm_per_rad))
+    return np.concatenate([target_rad[..., None], rel, lw, k], axis=-1)
+
+
+@dataclass(frozen=True)
+class Preview:
+    """What the walk engine knows ahead, robot frame: the next targets t+1 ... (rad) and this leg's load share
+    at t, t+1, ... (1)."""
+
+    target_rad: np.ndarray
+    load_share: np.ndarray
+
+
+class ReferenceBuffer:
+    """One knee's window built online: `push` the target at each step with the preview ahead, read `features`.
+
+    The preview arrives with each step (the walk engine's next `preview` targets and the load share
+    at t ... t+preview); past targets and load shares are kept here. Values in flexion.
+    """
+
+    def __init__(self, window: ReferenceWindow, k_Nm_per_rad: float) -> None:
+        self.window, self.k = window, float(k_Nm_per_rad)
+        self._past_t: list[float] = []
+        self._past_l: list[float] = []
+
+    def features(self, target_rad: float, preview_rad: np.ndarray, load_share: np.ndarray) -> np.ndarray:
+        """Input vector at this step; `preview_rad` (>= 0 values, t+1 ...) and `load_share` (t, t+1, ...),
+        each padded with its last value to the window."""
+        w = self.window
+        if not self._past_t:
+            self._past_t, self._past_l = [target_rad] * w.past, [float(load_share[0]) if len(load_share) else 0.0] * w.past
+        ahead_t = np.concatenate([[target_rad], np.asarray(preview_rad, float)])
+        ahead_l = np.asarray(load_share, float) if len(load_share) else np.zeros(1)
+        ahead_t = np.pad(ahead_t[: w.preview + 1], (0, max(0, w.preview + 1 - len(ahead_t))), mode="edge")
+        ahead_l = np.pad(ahead_l[: w.preview + 1], (0, max(0, w.preview + 1 - len(ahead_l))), mode="edge")
+        tw = np.concatenate([self._past_t[len(self._past_t) - w.past:] if w.past else [], ahead_t])
+        lw = np.concatenate([self._past_l[len(self._past_l) - w.past:] if w.past else [], ahead_l])
+        if w.past:
+            self._past_t = self._past_t[1:] + [target_rad]
+            self._past_l = self._past_l[1:] + [float(ahead_l[0])]
+        rel = np.delete(tw, w.past) - target_rad
+        return np.concatenate([[target_rad], rel, lw, [self.k]])
