@@ -41,6 +41,11 @@ def ccx() -> str:
 @pytest.fixture
 def spring_dict() -> dict:
     """A valid spring.json payload: the thesis's measured 9-beam 8 mm NinjaFlex spring on the Wolfgang-OP knee."""
+    return thesis_spring()
+
+
+def thesis_spring() -> dict:
+    """The payload of `spring_dict`, for module-scoped fixtures."""
     return {
         "schema_version": 1,
         "study": "wolfgang_knee",
