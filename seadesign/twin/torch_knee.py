@@ -26,7 +26,18 @@ Departures from the NumPy simulator, all for gradients:
   `quantise=False`.
 
 A rollout from a saved state (`state()` detached, `load_state`) makes truncated windows for
-backpropagation through time.
+backpropagation through time:
+
+    knee.reset(target[:, 0], stance[:, 0])
+    starts = []
+    with torch.no_grad():                         # one pass over the protocol records the window starts
+        for _ in range(n_windows):
+            starts.append(knee.state())
+            rollout(knee, policy, stance, window)
+    for start in starts:                          # then each window is trained from its start
+        knee.load_state(start)
+        out = rollout(knee, policy, stance, window)
+        loss(out).backward()
 """
 
 from __future__ import annotations
@@ -352,6 +363,10 @@ class TorchKnee:
     >>> knee = TorchKnee.from_session(session)            # or TorchKnee(config, chain, rate_hz=100.0)
     >>> obs = knee.reset(flexion_rad, stance)              # static equilibrium at the first target
     >>> for k in range(n): obs = knee.step(policy(obs, k), stance[:, k])
+
+    `rate_hz` sample (command) rate (Hz); `dtype` float64 or float32; `dead_zone_smoothing_rad` the dead zones'
+    smoothing width s (rad); `noise` draw the chain's sensor noise; `quantise` round like the chain's encoders
+    (straight-through gradient) or pass the value through; `seed` the noise streams' seed.
     """
 
     def __init__(self, config: KneeConfig, effects: EffectChain, *, rate_hz: float = 100.0,
@@ -404,9 +419,10 @@ class TorchKnee:
             return torch.zeros_like(like)
         return self.tensor(stance).expand_as(like)
 
-    def reset(self, flexion_rad: Any, stance: Any = None) -> TorchObservation:
+    def reset(self, flexion_rad: Any, stance: Any = None, seed: int | None = None) -> TorchObservation:
         """Start at the static equilibrium of the link under its loads (as `KneeSession`), motor at
-        `flexion_rad` (rad, batch shape (..., 2)), legs carrying `stance`; return the first observation."""
+        `flexion_rad` (rad, batch shape (..., 2)), legs carrying `stance`; the noise streams restart from
+        `seed` (default: the knee's). Return the first observation."""
         q0 = self.tensor(flexion_rad)
         stance0 = self._stance(stance, q0)
         cfg = self.config
@@ -421,6 +437,8 @@ class TorchKnee:
         states = {op.name: op.init(first) for ops in self.stages.values() for op in ops if op.stateful}
         torque, load, states = self._torques(q0, angle, zero, stance0, 0.0, states, 0.0)
         self.options.generators.clear()
+        if seed is not None:
+            self.options.seed = int(seed)
         self._s = {"qm": q0, "omega": zero, "vel": zero, "angle": angle, "spring_torque": torque,
                    "load_torque": load, "effects": states, "prev_hall": None, "step": 0, "time_s": 0.0}
         return self._sense()
@@ -430,6 +448,8 @@ class TorchKnee:
         substeps), legs carrying `stance` over it; return the next sample's observation."""
         s = self._require()
         cmd = self.tensor(command_flex_rad)
+        if torch.broadcast_shapes(cmd.shape, s["qm"].shape) != s["qm"].shape:
+            raise ConfigError(f"command of shape {tuple(cmd.shape)} does not fit the knees' {tuple(s['qm'].shape)}")
         stance_t = self._stance(stance, s["qm"])
         cfg = self.config
         h = self.dt / self.n_sub
