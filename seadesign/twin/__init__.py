@@ -9,6 +9,9 @@ Public API (stable):
 - `Trial`, `thesis_protocol(duration_s, repeats)`, `DIRECTIONS`, `SPEEDS`, `Gait`: the walk protocol.
 - `KneeConfig`, `knee_effects(cfg, ground)`, `bench_effects(k, curve)`, `configure_chain(chain, options)`.
 - `BenchProtocol`, `simulate_bench(spring, protocol, effects=, seed=) -> (table, metadata)`.
+- `seadesign.twin.torch_knee` (imported from its module, it loads torch): `TorchKnee`, the knee simulator
+  in differentiable PyTorch built from the same config and effect chain, with `rollout` and `protocol_tensors`
+  for training through the closed loop.
 
 Simulated tables are written with `seadesign.data.write_recording` / `write_bench` and the
 metadata as the `<name>.meta.json` sidecar.

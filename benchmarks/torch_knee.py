@@ -1,0 +1,82 @@
+"""Speed of the differentiable torch knee in training windows: simulated steps per second.
+
+Run: python benchmarks/torch_knee.py [--windows 100 200] [--threads 1 2] [--repeats 3]. Prints a table with
+the machine and settings. One step = one 10 ms sample of the whole batch (36 knees: the thesis protocol's
+18 trials x 2 knees) with all substeps, default effects on the ground (noise drawn, quantisation straight-through),
+the command = the walk target plus a learnable offset per knee; forward = the window's rollout without a graph,
+forward+backward = the rollout with its graph and the backward pass of the mean squared Hall error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import numpy as np
+import torch
+
+from seadesign import __version__
+from seadesign.twin import KneeConfig, knee_effects, thesis_protocol
+from seadesign.twin.torch_knee import TorchKnee, protocol_tensors, rollout
+
+SPRING = {
+    "schema_version": 1, "study": "benchmark", "k_source": "measured", "k_Nm_per_rad": 9.106, "k_rel_error": None,
+    "design": {"beam_count": 9, "beam_thickness_mm": 8.0},
+    "material": {"name": "ninjaflex", "youngs_modulus_Pa": 12e6, "poisson_ratio": 0.48,
+                 "density_kg_per_m3": 1190.0, "yield_strength_Pa": 4e6},
+    "actuator": {"stall_torque_Nm": 11.7, "no_load_speed_rad_per_s": 46 * 2 * np.pi / 60, "gear_ratio": 272.5,
+                 "backlash_rad": np.deg2rad(0.25)},
+    "robot": {"mass_kg": 8.0, "lower_leg_m": 0.2038, "upper_leg_m": 0.2},
+    "inputs_hash": "0123456789abcdef", "versions": {"seadesign": __version__},
+}
+
+
+def steps_per_s(knee: TorchKnee, target: torch.Tensor, stance: torch.Tensor, window: int, backward: bool,
+                repeats: int) -> float:
+    """Best of `repeats` windows starting at sample 100 (walking): simulated steps per second."""
+    offset = torch.zeros(2, dtype=target.dtype, requires_grad=backward)
+    knee.reset(target[:, 0], stance[:, 0])
+    with torch.no_grad():
+        rollout(knee, lambda obs, k: target[:, k], stance, 100)
+    start = knee.state()
+    best = float("inf")
+    for _ in range(repeats):
+        knee.load_state(start)
+        t0 = time.perf_counter()
+        with torch.set_grad_enabled(backward):
+            out = rollout(knee, lambda obs, k: target[:, k] + offset, stance, window)
+            if backward:
+                ((out["hall_rad"] - target[:, 100:100 + window]) ** 2).mean().backward()
+        best = min(best, time.perf_counter() - t0)
+    return window / best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--windows", type=int, nargs="+", default=[100, 200], help="window lengths, samples")
+    parser.add_argument("--threads", type=int, nargs="+", default=[1, 2], help="torch intra-op threads")
+    parser.add_argument("--repeats", type=int, default=3, help="timed windows per setting (best is kept)")
+    args = parser.parse_args()
+    trials = thesis_protocol(10.0)
+    cfg = KneeConfig.from_spring(SPRING)
+    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores, {platform.processor() or '?'}; "
+          f"python {platform.python_version()}, torch {torch.__version__}, seadesign {__version__}")
+    print(f"settings: batch {len(trials)} trials x 2 knees, 100 Hz, ground, default effects, noise on; "
+          f"best of {args.repeats}")
+    print(f"{'dtype':>8} {'threads':>7} {'window':>6} {'forward steps/s':>16} {'fwd+bwd steps/s':>16}")
+    for dtype in (torch.float32, torch.float64):
+        _, target, stance = protocol_tensors(trials, dtype=dtype)
+        knee = TorchKnee(cfg, knee_effects(cfg, ground=True), dtype=dtype, noise=True)
+        for threads in args.threads:
+            torch.set_num_threads(threads)
+            for window in args.windows:
+                fwd = steps_per_s(knee, target, stance, window, False, args.repeats)
+                both = steps_per_s(knee, target, stance, window, True, args.repeats)
+                print(f"{str(dtype).removeprefix('torch.'):>8} {threads:>7} {window:>6} {fwd:>16.0f} {both:>16.0f}",
+                      flush=True)
+
+
+if __name__ == "__main__":
+    main()
