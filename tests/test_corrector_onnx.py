@@ -59,6 +59,7 @@ class _Records(logging.Handler):
         self.records.append(record)
 
 
+TORCH_LOGGERS = ("torch", "torch.onnx")  # torch.onnx does not propagate to torch
 EXPORT_NOISE: list[str] = []  # warnings and log records seen while the bundles fixture exported
 
 
@@ -70,13 +71,16 @@ def bundles(tmp_path_factory):
     for model in MODELS:
         net, meta, X = _train(model)
         handler = _Records()
-        logging.getLogger("torch").addHandler(handler)
+        loggers = [logging.getLogger(name) for name in TORCH_LOGGERS]
+        for log in loggers:
+            log.addHandler(handler)
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
                 out[model] = (export_bundle(net, meta, tmp_path_factory.mktemp(model)), net, X, meta)
         finally:
-            logging.getLogger("torch").removeHandler(handler)
+            for log in loggers:
+                log.removeHandler(handler)
         EXPORT_NOISE.extend([str(w.message) for w in caught] + [r.getMessage() for r in handler.records])
     return out
 
@@ -116,7 +120,7 @@ def test_onnx_torch_and_numpy_agree_to_1e6_rad(bundles, model):
         np.testing.assert_allclose(ox(x[:1]), ref[:1], rtol=0, atol=1e-6)  # batch of one
 
 
-def test_onnx_graph_has_dynamic_batch_and_normalisation_inside(bundles):
+def test_onnx_graph_has_dynamic_batch_and_single_call_session(bundles):
     import onnx
 
     proto = onnx.load(str(bundles["mlp"][0] / "corrector.onnx"))
@@ -125,6 +129,10 @@ def test_onnx_graph_has_dynamic_batch_and_normalisation_inside(bundles):
     assert x.name == "x" and dims[0].dim_param and dims[1].dim_value == len(bundles["mlp"][3]["inputs"])
     assert [o.name for o in proto.graph.output] == ["command_rad"]
     assert not (bundles["mlp"][0] / "corrector.onnx.data").exists()  # one self-contained file
+    ort = require_module("onnxruntime", INSTALL)
+    opts = load_onnx(bundles["mlp"][0]).session.get_session_options()  # tuned for single calls in a 1 kHz loop
+    assert opts.intra_op_num_threads == 1 and opts.execution_mode == ort.ExecutionMode.ORT_SEQUENTIAL
+    assert opts.graph_optimization_level == ort.GraphOptimizationLevel.ORT_ENABLE_ALL
 
 
 @pytest.mark.parametrize("model", MODELS)
