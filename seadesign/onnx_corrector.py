@@ -26,7 +26,9 @@ INSTALL = "pip install 'seadesign[onnx]' (on the robot, `pip install onnxruntime
 
 class OnnxCorrector:
     """corrector.onnx in one ONNX Runtime session tuned for single calls (1 thread, sequential,
-    all graph optimisations); same outputs as `NumpyCorrector`."""
+    all graph optimisations; a single vector goes through input and output buffers bound once,
+    which saves about a quarter of a call, so one instance serves one thread); same outputs as
+    `NumpyCorrector`."""
 
     def __init__(self, path: str | Path) -> None:
         try:
@@ -47,17 +49,23 @@ class OnnxCorrector:
         self.input_units: list[str] = self.meta["input_units"]
         self._input = self.session.get_inputs()[0].name
         self._outputs = [self.session.get_outputs()[0].name]
+        self._x1 = np.zeros((1, len(self.input_names)), np.float32)
+        self._u1 = np.zeros(1, np.float32)
+        self._binding = self.session.io_binding()
+        self._binding.bind_ortvalue_input(self._input, ort.OrtValue.ortvalue_from_numpy(self._x1))
+        self._binding.bind_ortvalue_output(self._outputs[0], ort.OrtValue.ortvalue_from_numpy(self._u1))
 
     def __call__(self, x: np.ndarray) -> np.ndarray | float:
         """Raw SI inputs (d,) or (B, d), in the order of `input_names` -> command(s), rad."""
         x = np.asarray(x, dtype=np.float32)
-        single = x.ndim == 1
-        xb = x[None, :] if single else x
-        if xb.ndim != 2 or xb.shape[1] != len(self.input_names):
+        if x.ndim not in (1, 2) or x.shape[-1] != len(self.input_names):
             raise SeadesignError(f"the corrector takes {len(self.input_names)} inputs ({', '.join(self.input_names)}) "
                                  f"as a vector (d,) or a batch (B, d); got shape {x.shape}")
-        u = self.session.run(self._outputs, {self._input: xb})[0]
-        return float(u[0]) if single else u
+        if x.ndim == 1:
+            self._x1[0] = x
+            self.session.run_with_iobinding(self._binding)
+            return float(self._u1[0])
+        return self.session.run(self._outputs, {self._input: x})[0]
 
 
 def load_onnx(bundle: str | Path) -> OnnxCorrector:
