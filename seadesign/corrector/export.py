@@ -228,7 +228,6 @@ def export_onnx(net: CorrectorNet, meta: dict[str, Any], path: str | Path) -> Pa
     try:
         with warnings.catch_warnings():  # torch.export's pytree internals warn about their own API
             warnings.simplefilter("ignore", FutureWarning)
-            warnings.simplefilter("ignore", DeprecationWarning)
             program = torch.onnx.export(net.cpu().eval(), (torch.zeros(2, d),), input_names=["x"],
                                         output_names=["command_rad"], dynamic_shapes=({0: torch.export.Dim("batch")},),
                                         dynamo=True, verbose=False)
