@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import importlib
 import os
 import shutil
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 
@@ -30,6 +32,18 @@ def require_tool(name: str, install: str) -> str:
             pytest.fail(message + "; CI installs it, so this test must run there")
         pytest.skip(message)
     return path
+
+
+def require_module(name: str, install: str) -> ModuleType:
+    """An optional Python package; skip when it is missing, but fail under CI=true, where the CI
+    script installs it (as `require_tool`)."""
+    try:
+        return importlib.import_module(name)
+    except ImportError:
+        message = f"Python package `{name}` is not installed ({install})"
+        if os.environ.get("CI", "").lower() == "true":
+            pytest.fail(message + "; CI installs it, so this test must run there")
+        pytest.skip(message)
 
 
 @pytest.fixture

@@ -1,19 +1,30 @@
-"""Export a trained corrector: TorchScript (normalisation, input names and units baked in) and a
-plain NumPy path with the same outputs. A bundle directory holds:
+"""Export a trained corrector: TorchScript (normalisation, input names and units baked in), ONNX
+(for a robot without PyTorch) and a plain NumPy path, all with the same outputs. A bundle
+directory holds:
 
 - ``corrector.pt``: TorchScript; ``forward(x)`` maps raw SI inputs (B, d) to commands (B,) rad;
   ``input_names()`` / ``input_units()`` list the inputs; ``step(knee, target_rad, measured)`` runs
   it online (one knee, one control step: history window and right-knee mirroring inside,
   ``measured_names()`` lists the channels, ``reset()`` starts a trial); ``meta.json`` is
   embedded as an extra file.
+- ``corrector.onnx``: the flat ``forward`` (inputs ``x`` (B, d) raw SI -> ``command_rad`` (B,),
+  normalisation inside, dynamic batch), written through ``torch.onnx.export`` on ``torch.export``
+  when the ``onnx`` extra is installed; every meta.json field is embedded as a JSON-encoded
+  metadata property. Run it with `seadesign.onnx_corrector.load_onnx` (onnxruntime, no torch).
+  Without the exporter the other files are still written and meta.json's ``onnx.skipped`` says why.
 - ``corrector.npz``: weights and normalisation for `NumpyCorrector`.
-- ``meta.json``: dataset spec, model kind, k, split, training settings and curve, versions.
+- ``meta.json``: dataset spec, model kind, k, inputs and units, normalisation, split, training
+  settings and curve, whatever else the caller records (e.g. simulator and control rate),
+  ONNX status, versions.
 """
 
 
+import importlib
 import json
+import logging
 import platform
 import warnings
+from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +39,8 @@ from seadesign.corrector.models import CorrectorNet, MLPCore, SiameseCore
 from seadesign.errors import SeadesignError
 
 LEAKY_SLOPE = 0.01  # torch.nn.LeakyReLU default
+ONNX_FILE = "corrector.onnx"
+ONNX_INSTALL = "pip install 'seadesign[onnx]'"
 
 
 class _Exported(nn.Module):
@@ -105,9 +118,15 @@ class _Exported(nn.Module):
 
 
 def versions() -> dict[str, str]:
-    """Package versions and machine recorded with every model and result."""
-    return {"seadesign": __version__, "torch": torch.__version__, "numpy": np.__version__,
-            "python": platform.python_version(), "machine": f"{platform.system()} {platform.machine()}"}
+    """Package versions (the ONNX ones where installed) and machine recorded with every model and result."""
+    found = {"seadesign": __version__, "torch": torch.__version__, "numpy": np.__version__,
+             "python": platform.python_version(), "machine": f"{platform.system()} {platform.machine()}"}
+    for name in ("onnx", "onnxscript", "onnxruntime"):
+        try:
+            found[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            pass
+    return found
 
 
 def input_list(feature_names: tuple[str, ...], siamese: bool) -> list[str]:
@@ -177,15 +196,67 @@ class NumpyCorrector:
         return float(u[0]) if single else u
 
 
+def normalisation(net: CorrectorNet) -> dict[str, Any]:
+    """u = base_w . x + y_mean + y_std * core((x - x_mean) / x_std): x_mean, x_std in the input
+    units, base_w in rad per input unit, y_mean and y_std in rad."""
+    return {k: getattr(net, k).detach().cpu().float().tolist() for k in ("x_mean", "x_std", "y_mean", "y_std", "base_w")}
+
+
+def onnx_exporter_missing() -> str | None:
+    """Why corrector.onnx cannot be written here (the missing packages and the install command),
+    or None when the exporter's packages import."""
+    missing = []
+    for name in ("onnx", "onnxscript"):
+        try:
+            importlib.import_module(name)
+        except ImportError:
+            missing.append(name)
+    if not missing:
+        return None
+    return f"{' and '.join(missing)} not installed, so no {ONNX_FILE} was written; install with {ONNX_INSTALL}"
+
+
+def export_onnx(net: CorrectorNet, meta: dict[str, Any], path: str | Path) -> Path:
+    """Write the network's flat forward as ONNX (input ``x`` (B, d) raw SI, output
+    ``command_rad`` (B,), dynamic batch) with every `meta` field as a JSON metadata property."""
+    import onnx
+
+    d = net.x_mean.shape[0]
+    log = logging.getLogger("torch.onnx")  # warns once per export that torchvision's ops are absent
+    level = log.level
+    log.setLevel(logging.ERROR)
+    try:
+        with warnings.catch_warnings():  # torch.export's pytree internals warn about their own API
+            warnings.simplefilter("ignore", FutureWarning)
+            program = torch.onnx.export(net.cpu().eval(), (torch.zeros(2, d),), input_names=["x"],
+                                        output_names=["command_rad"], dynamic_shapes=({0: torch.export.Dim("batch")},),
+                                        dynamo=True, verbose=False)
+    finally:
+        log.setLevel(level)
+    proto = program.model_proto
+    proto.doc_string = "seadesign corrector: raw SI inputs x (B, d) -> motor position command (B,), rad"
+    onnx.helper.set_model_props(proto, {k: json.dumps(v, default=_json_default) for k, v in meta.items()})
+    onnx.checker.check_model(proto)
+    onnx.save_model(proto, str(path))  # one file: the weights are far below the 2 GB external-data limit
+    return Path(path)
+
+
 def export_bundle(net: CorrectorNet, meta: dict[str, Any], out_dir: str | Path) -> Path:
-    """Write corrector.pt, corrector.npz and meta.json into `out_dir`; meta["dataset"] is the
-    DatasetSpec as a dict (it fixes the online path's history and mirroring)."""
+    """Write corrector.pt, corrector.onnx (when the exporter is installed), corrector.npz and
+    meta.json into `out_dir`; meta["dataset"] is the DatasetSpec as a dict (it fixes the online
+    path's history and mirroring). Other fields (k, simulator settings, control rate) are kept."""
     spec = DatasetSpec.from_dict(meta["dataset"])
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     names = list(meta["inputs"])
     units = [unit_of(n.split("[")[0]) for n in names]
-    meta = {**meta, "input_units": units, "versions": versions()}
+    skipped = onnx_exporter_missing()
+    meta = {**meta, "input_units": units, "normalisation": normalisation(net),
+            "onnx": {"skipped": skipped} if skipped else {"file": ONNX_FILE}, "versions": versions()}
+    if skipped is None:
+        export_onnx(net, meta, out / ONNX_FILE)
+    else:
+        (out / ONNX_FILE).unlink(missing_ok=True)
     text = json.dumps(meta, indent=2, default=_json_default)
     with warnings.catch_warnings():  # TorchScript is deprecated upstream but is the requested format
         warnings.simplefilter("ignore", DeprecationWarning)
