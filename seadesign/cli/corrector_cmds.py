@@ -15,26 +15,31 @@ from seadesign.corrector.recordings import load_recordings
 from seadesign.corrector.report import write_table
 from seadesign.corrector.splits import SPLITS
 from seadesign.corrector.train import TrainConfig
-from seadesign.corrector.workflow import DEFAULT_HISTORY, candidate_name, evaluate_bundles, train_bundle
+from seadesign.corrector.workflow import DEFAULT_HISTORY, candidate_name, evaluate_bundles, train_bundle, train_reference_bundle
 from seadesign.design.spring import load_spring
 from seadesign.twin import thesis_protocol
 
 
+TRAIN_KINDS = ("reference", *MODEL_KINDS)
+
+
 def _models(text: str) -> list[str]:
     models = [m.strip() for m in text.split(",") if m.strip()]
-    bad = [m for m in models if m not in MODEL_KINDS]
+    bad = [m for m in models if m not in TRAIN_KINDS]
     if bad or not models:
-        raise click.BadParameter(f"unknown model(s) {bad}; choose from {', '.join(MODEL_KINDS)} (comma-separated)")
+        raise click.BadParameter(f"unknown model(s) {bad}; choose from {', '.join(TRAIN_KINDS)} (comma-separated)")
     return models
 
 
 @main.command()
 @click.option("--spring", "spring_path", required=True, type=click.Path(dir_okay=False),
               help="spring.json from `seadesign sweep` (k is read from it; the file must pass its schema)")
-@click.option("--data", "data", required=True, multiple=True, type=click.Path(exists=True, dir_okay=False),
-              help="robot recording CSV (repeat for several files)")
-@click.option("--model", "model_text", default="mlp", show_default=True,
-              help=f"one or more of {', '.join(MODEL_KINDS)}, comma-separated")
+@click.option("--data", "data", multiple=True, type=click.Path(exists=True, dir_okay=False),
+              help="robot recording CSV (repeat for several files); needed by every model but 'reference'")
+@click.option("--model", "model_text", default="reference", show_default=True,
+              help=f"one or more of {', '.join(TRAIN_KINDS)}, comma-separated. reference: feed-forward from the "
+                   "walk engine's trajectory, trained on iterative-learning-control labels in the knee simulator "
+                   "(no measured state in the loop: the family that is stable in closed loop)")
 @click.option("--modalities", default="velocity_effort", show_default=True,
               help="a thesis combination name (target_only, velocity_effort, all, ...) or a comma-separated "
                    "list of motor_pos, hall_pos, motor_vel, hall_vel, effort, imu, pressure")
@@ -57,14 +62,25 @@ def _models(text: str) -> list[str]:
 def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: str, task: str, positive: bool,
           history: int | None, split_name: str, test_recording: tuple[str, ...], seed: int, max_epochs: int,
           patience: int, max_seconds: float, batch_size: int, lr: float, out: str | None) -> None:
-    """Train corrector network(s) on recordings and export TorchScript + NumPy bundles."""
+    """Train corrector network(s) and export bundles (TorchScript, ONNX, NumPy): by default the reference-window
+    feed-forward on ILC labels from the knee simulator built from spring.json; models on recordings with --model."""
     models = _models(model_text)
     spring = load_spring(spring_path)
-    recs = load_recordings(list(data))
+    if not data and any(m != "reference" for m in models):
+        raise click.BadParameter("models trained on recordings need --data FILE (repeat for several files)")
+    recs = load_recordings(list(data)) if data else []
     cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=max_seconds,
                       batch_size=batch_size, lr=lr)
     root = Path(out) if out else Path("exports") / spring["study"] / "corrector"
     for model in models:
+        if model == "reference":
+            target = root if (out and len(models) == 1) else root / "reference-ilc"
+            path, ref = train_reference_bundle(spring_path, target)
+            s = ref.summary()["training"]
+            click.echo(f"reference-ilc: ILC labels {ref.label_s:.0f} s ({len(ref.labels)} batches); best validation MSE "
+                       f"{s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} ({s['stopped']}, {s['wall_s']:.1f} s) "
+                       f"-> {path}")
+            continue
         h = history if history is not None else (DEFAULT_HISTORY if model == "history" else 0)
         spec = DatasetSpec(task, modalities, h, positive)
         name = candidate_name(model, spec)
@@ -94,16 +110,18 @@ def evaluate(bundles: tuple[str, ...], data: tuple[str, ...], json_path: str | N
     knee simulator; write tables (CSV, Markdown[, JSON]) and plots."""
     settings = tuple(s.strip() for s in closed_loop.split(",") if s.strip() and s.strip() != "none")
     res = evaluate_bundles(list(bundles), list(data), out, json_path, kp, ki, settings, trial_s)
-    both = [r for r in res["open_loop"] if r["knee"] == "both"]
-    click.echo(f"open loop ({res['settings']['rows']}):")
+    both = [r for r in res.get("open_loop", []) if r["knee"] == "both"]
+    if both:
+        click.echo(f"open loop ({res['settings']['rows']}):")
     for r in both:
         click.echo(f"  {r['candidate']:<45} MAE {r['mae_rad']:.4f} rad  MSE {r['mse_rad2']:.4g} rad^2  "
                    f"peak {r['peak_rad']:.3f} rad")
     for r in res.get("closed_loop", []):
         if "mean_abs_error_rad" in r:
-            flags = ", ".join(f for f in ("unstable", "oscillating") if r.get(f"{f}_flag"))
+            flags = ", ".join(f for f in ("unstable", "oscillating", "loop_gain") if r.get(f"{f}_flag"))
             click.echo(f"  closed loop {r['setting']:<8} {r['candidate']:<45} mean |Hall error| "
-                       f"{r['mean_abs_error_rad']:.4f} rad  peak {r['peak_abs_error_rad']:.3f} rad  {flags}")
+                       f"{r['mean_abs_error_rad']:.4f} rad  peak {r['peak_abs_error_rad']:.3f} rad  "
+                       f"margin {r['modulus_margin']:.2f}  {'stable' if r['stable'] else 'NOT stable: ' + flags}")
     for f in res["files"]:
         click.echo(f"wrote {f}")
 

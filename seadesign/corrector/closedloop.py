@@ -37,6 +37,7 @@ from seadesign.corrector.reference import Preview
 from seadesign.corrector.runtime import Corrector
 from seadesign.errors import ConfigError, SeadesignError
 from seadesign.twin import KneeSession, Trial, thesis_protocol
+from seadesign.twin.knee import Observation
 
 UNSTABLE_COMMAND_RAD = 1.5
 UNSTABLE_HALL_RAD = np.pi
@@ -68,33 +69,46 @@ def _needs_aux(corrector: Corrector) -> bool:
     return spec is not None and any(m in ("imu", "pressure") for m in spec.modalities)
 
 
+class Driver:
+    """One independent copy of a corrector per trial of a session; `commands(obs)` asks every copy for its
+    command (robot frame, (n_trials, 2) rad) from the observation and, when it previews, the walk engine's
+    next targets and load share."""
+
+    def __init__(self, corrector: Corrector, sim: KneeSession) -> None:
+        if _needs_aux(corrector):
+            raise SeadesignError(f"corrector '{corrector.name}' needs IMU/foot-pressure inputs, which the knee "
+                                 "simulator does not observe; train it on knee channels only for closed-loop use")
+        self.sim, self.copies = sim, []
+        for _ in range(sim.n_trials):
+            c = copy.deepcopy(corrector)
+            c.reset()
+            self.copies.append(c)
+        self.ahead = getattr(corrector, "preview_steps", 0)
+        self.load = sim.stance * float(sim.ground)
+
+    def commands(self, obs: Observation) -> np.ndarray:
+        sim, t, ahead = self.sim, obs.step, self.ahead
+        cmd = np.empty((sim.n_trials, 2))
+        for i, c in enumerate(self.copies):
+            for k, knee in enumerate(KNEES):
+                measured = {dst: float(getattr(obs, src)[i, k]) for src, dst in FIELD_CHANNELS.items()}
+                extra = {"preview": Preview(sim.target[i, t + 1: t + 1 + ahead, k], self.load[i, t: t + 1 + ahead, k])} \
+                    if ahead else {}
+                cmd[i, k] = c.command(knee, float(obs.target[i, k]), {**measured, **_ABSENT}, sim.dt, **extra)
+        return cmd
+
+
 def run_closed_loop(corrector: Corrector, spring: dict[str, Any], trials: list[Trial] | None = None,
                     ground: bool = False, rate_hz: float = 100.0, seed: int = 0, **session: Any) -> ClosedLoopRun:
     """Drive a KneeSession with `corrector` (one independent copy per trial); log and flag the run."""
-    if _needs_aux(corrector):
-        raise SeadesignError(f"corrector '{corrector.name}' needs IMU/foot-pressure inputs, which the knee "
-                             "simulator does not observe; train it on knee channels only for closed-loop use")
     trials = trials if trials is not None else thesis_protocol()
     sim = KneeSession(spring, trials, ground=ground, rate_hz=rate_hz, seed=seed, **session)
-    copies = []
-    for _ in trials:
-        c = copy.deepcopy(corrector)
-        c.reset()
-        copies.append(c)
+    driver = Driver(corrector, sim)
     shape = (sim.n_trials, sim.n_steps, 2)
     target, hall, command, effort = (np.full(shape, np.nan) for _ in range(4))
-    ahead = getattr(corrector, "preview_steps", 0)
-    load = sim.stance * float(ground)
     obs, unstable, note = sim.observe(), False, ""
     while obs is not None:
-        cmd = np.empty((sim.n_trials, 2))
-        t = obs.step
-        for i, c in enumerate(copies):
-            for k, knee in enumerate(KNEES):
-                measured = {dst: float(getattr(obs, src)[i, k]) for src, dst in FIELD_CHANNELS.items()}
-                extra = {"preview": Preview(sim.target[i, t + 1: t + 1 + ahead, k], load[i, t: t + 1 + ahead, k])} \
-                    if ahead else {}
-                cmd[i, k] = c.command(knee, float(obs.target[i, k]), {**measured, **_ABSENT}, sim.dt, **extra)
+        cmd = driver.commands(obs)
         target[:, obs.step], hall[:, obs.step], command[:, obs.step] = obs.target, obs.hall_pos, cmd
         effort[:, obs.step] = obs.knee_eff
         if not np.isfinite(cmd).all() or np.abs(cmd - obs.target).max() > UNSTABLE_COMMAND_RAD \

@@ -43,6 +43,29 @@ ONNX_FILE = "corrector.onnx"
 ONNX_INSTALL = "pip install 'seadesign[onnx]'"
 
 
+class _Forward(nn.Module):
+    """TorchScript wrapper of a network whose online inputs are built outside (the reference-window
+    family: `reference.ReferenceBuffer`): `forward` on flat raw inputs, with their names and units."""
+
+    names: list[str]
+    units: list[str]
+
+    def __init__(self, net: CorrectorNet, names: list[str], units: list[str]) -> None:
+        super().__init__()
+        self.net, self.names, self.units = net, names, units
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return self.net(x)
+
+    @torch.jit.export
+    def input_names(self) -> list[str]:
+        return self.names
+
+    @torch.jit.export
+    def input_units(self) -> list[str]:
+        return self.units
+
+
 class _Exported(nn.Module):
     """TorchScript wrapper: the network on flat raw inputs (`forward`), and the online path
     `step` that keeps each knee's history window and applies the right knee's mirroring, exactly
@@ -243,9 +266,9 @@ def export_onnx(net: CorrectorNet, meta: dict[str, Any], path: str | Path) -> Pa
 
 def export_bundle(net: CorrectorNet, meta: dict[str, Any], out_dir: str | Path) -> Path:
     """Write corrector.pt, corrector.onnx (when the exporter is installed), corrector.npz and
-    meta.json into `out_dir`; meta["dataset"] is the DatasetSpec as a dict (it fixes the online
-    path's history and mirroring). Other fields (k, simulator settings, control rate) are kept."""
-    spec = DatasetSpec.from_dict(meta["dataset"])
+    meta.json into `out_dir`; meta["dataset"], when present, is the DatasetSpec as a dict (it fixes the
+    online path's history and mirroring; without it corrector.pt has `forward` only). Other fields
+    (k, simulator settings, control rate) are kept."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     names = list(meta["inputs"])
@@ -260,7 +283,9 @@ def export_bundle(net: CorrectorNet, meta: dict[str, Any], out_dir: str | Path) 
     text = json.dumps(meta, indent=2, default=_json_default)
     with warnings.catch_warnings():  # TorchScript is deprecated upstream but is the requested format
         warnings.simplefilter("ignore", DeprecationWarning)
-        scripted = torch.jit.script(_Exported(net.cpu().eval(), names, units, spec))
+        module = _Exported(net.cpu().eval(), names, units, DatasetSpec.from_dict(meta["dataset"])) \
+            if "dataset" in meta else _Forward(net.cpu().eval(), names, units)
+        scripted = torch.jit.script(module)
         torch.jit.save(scripted, str(out / "corrector.pt"), _extra_files={"meta.json": text})
     np.savez(out / "corrector.npz", **numpy_arrays(net))
     (out / "meta.json").write_text(text + "\n")
@@ -294,4 +319,5 @@ def load_torchscript(bundle: str | Path, freeze: bool = True) -> torch.jit.Scrip
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
         mod = torch.jit.load(str(Path(bundle) / "corrector.pt"), map_location="cpu").eval()
-        return torch.jit.freeze(mod, preserved_attrs=["input_names", "input_units", "measured_names", "reset", "step"]) if freeze else mod
+        online = ["measured_names", "reset", "step"] if hasattr(mod, "step") else []
+        return torch.jit.freeze(mod, preserved_attrs=["input_names", "input_units", *online]) if freeze else mod

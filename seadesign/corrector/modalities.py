@@ -84,7 +84,9 @@ def channels(modalities: tuple[str, ...]) -> tuple[str, ...]:
 
 def unit_of(name: str) -> str:
     """The SI unit encoded in a channel or feature name."""
-    for suffix, unit in (("_rad_per_s", "rad/s"), ("_m_per_s2", "m/s^2"), ("_rad", "rad"), ("_Nm", "Nm")):
+    if name.startswith("load_share"):
+        return "1 (share of the body weight on this leg)"
+    for suffix, unit in (("_Nm_per_rad", "Nm/rad"), ("_rad_per_s", "rad/s"), ("_m_per_s2", "m/s^2"), ("_rad", "rad"), ("_Nm", "Nm")):
         if name.endswith(suffix) or f"{suffix}@" in name:
             return unit
     return "1 (pressure cell reading, as recorded)"

@@ -17,7 +17,10 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 UNITS = (("_norm_pi2", "(rad/pi)^2, the thesis's normalised positions"), ("_rad2", "rad^2"), ("_rad", "rad"),
-         ("_pct", "%"), ("_s", "s"), ("_flag", "true/false"), ("n_", "count"))
+         ("_pct", "%"), ("_s", "s"), ("_hz", "Hz"), ("_flag", "true/false"), ("n_", "count"),
+         ("modulus_margin", "1, min over frequency of |1 + L| (L: loop gain)"),
+         ("crossover_gain", "1, |L| where L crosses the negative real axis (1 / gain margin)"),
+         ("loop_gain_peak", "1, max |L|"), ("margin_coherence", "1, coherence of L at the margin's frequency"))
 
 
 def unit_of_column(name: str) -> str | None:

@@ -22,12 +22,15 @@ from seadesign.corrector.export import export_bundle, input_list, load_meta, loa
 from seadesign.corrector.modalities import COMBINATIONS
 from seadesign.corrector.recordings import load_recordings
 from seadesign.corrector.report import plot_curves, plot_predictions, write_table
-from seadesign.corrector.runtime import Corrector, FeedForward, HallPI, NetCorrector, NoCorrection
+from seadesign.corrector.imitation import ImitationResult, ImitationSettings, train_imitation
+from seadesign.corrector.reference import ReferenceWindow
+from seadesign.corrector.runtime import Corrector, FeedForward, HallPI, NetCorrector, NoCorrection, ReferenceFeedForward
+from seadesign.corrector.stability import MIN_MODULUS_MARGIN, loop_gain_table
 from seadesign.corrector.splits import Split, make_split
 from seadesign.corrector.train import TrainConfig, TrainResult, fit
 from seadesign.errors import SeadesignError
 from seadesign.design.spring import load_spring, torque_curve
-from seadesign.twin import thesis_protocol
+from seadesign.twin import KneeConfig, knee_effects, thesis_protocol
 
 DEFAULT_HISTORY = 3  # samples, for the history model when no --history is given
 
@@ -80,6 +83,32 @@ def train_bundle(spring_path: str | Path, data_paths: list[str | Path], model: s
     return out, result
 
 
+def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
+                           settings: ImitationSettings = ImitationSettings()) -> tuple[Path, ImitationResult]:
+    """Family 1: ILC labels in the simulator built from spring.json, the reference-window network trained on
+    them, exported as a bundle whose meta records the window, k, the simulator and the control rate."""
+    spring = load_spring(spring_path)
+    result = train_imitation(spring, settings)
+    config = KneeConfig.from_spring(spring)
+    meta = {
+        "name": "reference-ilc", "model": "reference", "reference": settings.window.to_dict(),
+        "inputs": list(settings.window.feature_names()),
+        "output": "motor position command at t, rad, knee flexion (mirror the right knee in and out)",
+        "k_Nm_per_rad": float(spring["k_Nm_per_rad"]),
+        "spring": {"path": str(Path(spring_path).resolve()), "study": spring["study"], "k_source": spring["k_source"],
+                   "inputs_hash": spring["inputs_hash"]},
+        "control_rate_hz": settings.rate_hz,
+        "simulator": {"config": config.as_dict(), "settings": list(settings.settings),
+                      "effects": {s_: knee_effects(config, s_ == "ground").describe() for s_ in settings.settings}},
+        "data": [], "n_samples": int(sum(r.target_rad.size for r in result.labels)),
+        "split": {"split": "held_out_trials", "val_every": settings.val_every},
+        "training": result.summary(),
+    }
+    out = export_bundle(result.training.net, meta, out_dir)
+    pd.DataFrame(result.training.curve).to_csv(out / "training_curve.csv", index=False)
+    return out, result
+
+
 def find_bundles(paths: list[str | Path]) -> list[Path]:
     """Bundle directories among `paths` (a bundle itself, or a folder holding bundles)."""
     found: list[Path] = []
@@ -94,9 +123,12 @@ def find_bundles(paths: list[str | Path]) -> list[Path]:
     return found
 
 
-def load_corrector(bundle: str | Path) -> tuple[NetCorrector, dict[str, Any]]:
+def load_corrector(bundle: str | Path) -> tuple[Corrector, dict[str, Any]]:
     """A bundle as an online corrector (NumPy path) plus its meta."""
     meta = load_meta(bundle)
+    if meta["model"] == "reference":
+        return ReferenceFeedForward(load_numpy(bundle), ReferenceWindow(**meta["reference"]), meta["k_Nm_per_rad"],
+                                    name=meta["name"]), meta
     spec = DatasetSpec.from_dict(meta["dataset"])
     return NetCorrector(load_numpy(bundle), spec, meta["name"]), meta
 
@@ -131,39 +163,55 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
     then, for each setting in `closed_loop`, the closed-loop table in the knee simulator (thesis
     protocol, `trial_s` s per trial) built from the spring.json the first bundle was trained with.
 
-    Rows scored open loop: see `evaluation_rows` (decided by the first bundle). Default output
+    Rows scored open loop: see `evaluation_rows` (decided by the first bundle that reads measurements;
+    the reference-window family reads none and is not scored there). The closed-loop table carries each
+    corrector's loop-gain margins (`stability.measure_loop_gain`) and a `stable` verdict. Default output
     folder: exports/<study>/corrector/evaluation.
     """
     bundles = find_bundles(bundle_paths)
     nets = [load_corrector(b) for b in bundles]
-    ref_meta = nets[0][1]
-    k = float(ref_meta["k_Nm_per_rad"])
-    out = Path(out_dir) if out_dir else Path("exports") / ref_meta["spring"]["study"] / "corrector" / "evaluation"
-    recs = load_recordings(data_paths)
-    ds, split, rows_note = evaluation_rows(ref_meta, data_paths, recs)
-    spring_file = Path(ref_meta["spring"]["path"])
+    k = float(nets[0][1]["k_Nm_per_rad"])
+    spring_meta = nets[0][1]["spring"]
+    out = Path(out_dir) if out_dir else Path("exports") / spring_meta["study"] / "corrector" / "evaluation"
+    spring_file = Path(spring_meta["path"])
     spring = load_spring(spring_file) if spring_file.exists() else None
     curve = torque_curve(spring) if spring is not None else None
     feed_forward = (f"the torque curve of {spring_file}" if curve is not None else
                     f"k = {k:g} Nm/rad" + ("" if spring is not None else f" ({spring_file} not found)"))
     correctors: list[Corrector] = [NoCorrection(), HallPI(kp, ki), FeedForward(k, curve)] + [c for c, _ in nets]
-    table, traces = open_loop_table(correctors, recs, ds, split.test, split.name)
-    context = {"rows": rows_note, "reference_bundle": str(bundles[0]), "data": data_record(data_paths),
+    measured = [(b, c, m) for b, (c, m) in zip(bundles, nets) if m["model"] != "reference"]
+    context = {"reference_bundle": str(bundles[0]), "data": data_record(data_paths),
                "k_Nm_per_rad": k, "feed_forward_spring": feed_forward, "pi": {"kp": kp, "ki": ki}, "versions": versions(),
                "candidates": {m["name"]: {"bundle": str(b), "training": m["training"], "split": m["split"]}
-                              for b, (_, m) in zip(bundles, nets)}}
-    files = write_table(table, out, "open_loop", context)
-    plots = [plot_predictions(traces, out / "predictions_left.png", knee=0),
-             plot_predictions(traces, out / "predictions_right.png", knee=1),
-             plot_curves({m["name"]: pd.read_csv(b / "training_curve.csv").to_dict("records")
-                          for b, (_, m) in zip(bundles, nets)}, out / "training_curves.png")]
-    result = {"open_loop": table.to_dict("records"), "settings": context,
-              "files": [str(p) for p in [*files.values(), *plots]]}
+                              for b, (_, m) in zip(bundles, nets)},
+               "not_judged_open_loop": [m["name"] for _, m in nets if m["model"] == "reference"]}
+    result: dict[str, Any] = {"settings": context, "files": []}
+    if measured:  # the reference-window family reads no measurement: nothing to score on recordings
+        recs = load_recordings(data_paths)
+        ds, split, context["rows"] = evaluation_rows(measured[0][2], data_paths, recs)
+        ol = [c for c in correctors if not getattr(c, "preview_steps", 0)]
+        table, traces = open_loop_table(ol, recs, ds, split.test, split.name)
+        files = write_table(table, out, "open_loop", context)
+        plots = [plot_predictions(traces, out / "predictions_left.png", knee=0),
+                 plot_predictions(traces, out / "predictions_right.png", knee=1)]
+        result["open_loop"] = table.to_dict("records")
+        result["files"] += [str(p) for p in [*files.values(), *plots]]
+    curves = plot_curves({m["name"]: pd.read_csv(b / "training_curve.csv").to_dict("records")
+                          for b, (_, m) in zip(bundles, nets)}, out / "training_curves.png")
+    result["files"].append(str(curves))
     if closed_loop:
         spring = load_spring(spring_file)  # a clear error when it is gone: the simulator needs it
-        cl_table, _ = closed_loop_table(correctors, spring, closed_loop, thesis_protocol(trial_s), seed=seed)
+        trials = thesis_protocol(trial_s)
+        cl_table, _ = closed_loop_table(correctors, spring, closed_loop, trials, seed=seed)
+        gains = loop_gain_table([c for c in correctors], spring, closed_loop, trials, seed=seed)
+        cl_table = cl_table.merge(gains, on=["candidate", "setting"], how="left")
+        cl_table["stable"] = ~(cl_table.unstable_flag.astype(bool) | cl_table.oscillating_flag.astype(bool)
+                               | cl_table.loop_gain_flag.astype(bool))
         cl_context = {"protocol": f"thesis: 6 directions x 3 speeds, {trial_s:g} s each", "seed": seed,
-                      "spring": ref_meta["spring"], "versions": versions()}
+                      "spring": spring_meta, "versions": versions(),
+                      "stability": f"stable = no unstable or oscillating flag and a loop-gain modulus margin >= "
+                                   f"{MIN_MODULUS_MARGIN:g} with crossover gain <= {MIN_MODULUS_MARGIN:g} "
+                                   "(seadesign.corrector.stability)"}
         cl_files = write_table(cl_table, out, "closed_loop", cl_context)
         result["closed_loop"] = cl_table.to_dict("records")
         result["closed_loop_settings"] = cl_context
