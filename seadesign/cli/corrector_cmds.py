@@ -94,8 +94,9 @@ def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: 
 
 @main.command()
 @click.argument("bundles", nargs=-1, required=True, type=click.Path(exists=True, file_okay=False))
-@click.option("--data", "data", required=True, multiple=True, type=click.Path(exists=True, dir_okay=False),
-              help="recording CSV(s) to evaluate on; training files contribute only their held-out rows")
+@click.option("--data", "data", multiple=True, type=click.Path(exists=True, dir_okay=False),
+              help="recording CSV(s) for the open-loop table; training files contribute only their held-out rows "
+                   "(without: closed loop only)")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None, help="also write results as JSON")
 @click.option("-o", "--out", "out", type=click.Path(file_okay=False), default=None,
               help="output folder; default exports/<study>/corrector/evaluation")

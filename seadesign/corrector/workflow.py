@@ -180,13 +180,13 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
                     f"k = {k:g} Nm/rad" + ("" if spring is not None else f" ({spring_file} not found)"))
     correctors: list[Corrector] = [NoCorrection(), HallPI(kp, ki), FeedForward(k, curve)] + [c for c, _ in nets]
     measured = [(b, c, m) for b, (c, m) in zip(bundles, nets) if m["model"] != "reference"]
-    context = {"reference_bundle": str(bundles[0]), "data": data_record(data_paths),
+    context = {"reference_bundle": str(bundles[0]), "data": data_record(data_paths) if data_paths else [],
                "k_Nm_per_rad": k, "feed_forward_spring": feed_forward, "pi": {"kp": kp, "ki": ki}, "versions": versions(),
                "candidates": {m["name"]: {"bundle": str(b), "training": m["training"], "split": m["split"]}
                               for b, (_, m) in zip(bundles, nets)},
                "not_judged_open_loop": [m["name"] for _, m in nets if m["model"] == "reference"]}
     result: dict[str, Any] = {"settings": context, "files": []}
-    if measured:  # the reference-window family reads no measurement: nothing to score on recordings
+    if measured and data_paths:  # the reference-window family reads no measurement: nothing to score on recordings
         recs = load_recordings(data_paths)
         ds, split, context["rows"] = evaluation_rows(measured[0][2], data_paths, recs)
         ol = [c for c in correctors if not getattr(c, "preview_steps", 0)]
