@@ -31,7 +31,8 @@ def test_reference_bundle_records_its_simulator_and_runs_as_trained(tmp_path):
     drives the knee exactly as the network in memory; TorchScript and NumPy agree on the label inputs."""
     spring = thesis_spring()
     path = write_spring(spring, tmp_path / "spring.json")
-    bundle, result = train_reference_bundle(path, tmp_path / "ref", SMALL)
+    bundle, result, checks = train_reference_bundle(path, tmp_path / "ref", SMALL)
+    assert checks == [] and meta_check(bundle) == []
     meta = json.loads((bundle / "meta.json").read_text())
     assert meta["model"] == "reference" and meta["reference"] == {"past": 5, "preview": 10}
     assert meta["k_Nm_per_rad"] == spring["k_Nm_per_rad"] and meta["control_rate_hz"] == 100.0
@@ -48,6 +49,10 @@ def test_reference_bundle_records_its_simulator_and_runs_as_trained(tmp_path):
     mem = ReferenceFeedForward(NumpyCorrector(numpy_arrays(result.training.net)), SMALL.window, spring["k_Nm_per_rad"])
     b = run_closed_loop(mem, spring, trials)
     np.testing.assert_array_equal(a.command, b.command)
+
+
+def meta_check(bundle) -> list:
+    return json.loads((bundle / "meta.json").read_text())["simulator_check"]
 
 
 def _goal(runs: dict) -> pd.DataFrame:
@@ -81,3 +86,22 @@ def test_default_train_meets_the_closed_loop_goal_on_unseen_trajectories_and_rob
         assert not table.flagged.any(), case.name
         keeps = table.gain.to_numpy() >= ROBUST_SHARE * nominal.gain.to_numpy()
         assert keeps.all(), (case.name, table[~keeps])
+
+
+@pytest.mark.parametrize("scale", [1.0, 2.0])
+def test_simulator_check_reads_the_robots_stiffness_from_its_recording(tmp_path, scale):
+    """A recording simulated with the spring's stiffness x `scale`: the check recovers the scale and says whether
+    it lies in the range the corrector is tested for (0.7-1.4)."""
+    from seadesign.corrector.simcheck import check_simulator
+    from seadesign.data import write_recording
+    from seadesign.twin import KneeConfig, KneeSession, knee_effects
+
+    spring = thesis_spring()
+    chain = knee_effects(KneeConfig.from_spring(spring)).configure("stiffness_scale", enabled=True, scale=scale)
+    session = KneeSession(spring, [Trial("front", 0.1, 15.0), Trial("right", 0.2, 15.0)], effects=chain)
+    path = write_recording(session.run(), tmp_path / "walk.csv", metadata=session.metadata())
+    checks = check_simulator(spring, [path])
+    assert [c.knee for c in checks] == ["l", "r"]
+    for c in checks:
+        assert c.stiffness_scale == pytest.approx(scale, rel=0.06)  # measured 1.8-3 % low
+        assert c.within_robust_range == (scale == 1.0)

@@ -35,7 +35,8 @@ def _models(text: str) -> list[str]:
 @click.option("--spring", "spring_path", required=True, type=click.Path(dir_okay=False),
               help="spring.json from `seadesign sweep` (k is read from it; the file must pass its schema)")
 @click.option("--data", "data", multiple=True, type=click.Path(exists=True, dir_okay=False),
-              help="robot recording CSV (repeat for several files); needed by every model but 'reference'")
+              help="robot recording CSV (repeat for several files); trains every model but 'reference', which uses "
+                   "them to check its simulator (k and effects, by the loop)")
 @click.option("--model", "model_text", default="reference", show_default=True,
               help=f"one or more of {', '.join(TRAIN_KINDS)}, comma-separated. reference: feed-forward from the "
                    "walk engine's trajectory, trained on iterative-learning-control labels in the knee simulator "
@@ -75,7 +76,12 @@ def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: 
     for model in models:
         if model == "reference":
             target = root if (out and len(models) == 1) else root / "reference-ilc"
-            path, ref = train_reference_bundle(spring_path, target)
+            path, ref, checks = train_reference_bundle(spring_path, target, data_paths=list(data))
+            for c in checks:
+                click.echo(("" if c.within_robust_range else "WARNING: ") + "simulator check: " + c.text())
+            if any(not c.within_robust_range for c in checks):
+                click.echo("WARNING: the robot's k is outside what this corrector was tested for; calibrate "
+                           "spring.json first (seadesign explain, then sweep --calibration)")
             s = ref.summary()["training"]
             click.echo(f"reference-ilc: ILC labels {ref.label_s:.0f} s ({len(ref.labels)} batches); best validation MSE "
                        f"{s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} ({s['stopped']}, {s['wall_s']:.1f} s) "

@@ -25,6 +25,7 @@ from seadesign.corrector.report import plot_curves, plot_predictions, write_tabl
 from seadesign.corrector.imitation import ImitationResult, ImitationSettings, train_imitation
 from seadesign.corrector.reference import ReferenceWindow
 from seadesign.corrector.runtime import Corrector, FeedForward, HallPI, NetCorrector, NoCorrection, ReferenceFeedForward
+from seadesign.corrector.simcheck import SimulatorCheck, check_simulator
 from seadesign.corrector.stability import MIN_MODULUS_MARGIN, loop_gain_table
 from seadesign.corrector.splits import Split, make_split
 from seadesign.corrector.train import TrainConfig, TrainResult, fit
@@ -84,10 +85,13 @@ def train_bundle(spring_path: str | Path, data_paths: list[str | Path], model: s
 
 
 def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
-                           settings: ImitationSettings = ImitationSettings()) -> tuple[Path, ImitationResult]:
+                           settings: ImitationSettings = ImitationSettings(), data_paths: list[str | Path] = (),
+                           ) -> tuple[Path, ImitationResult, list[SimulatorCheck]]:
     """Family 1: ILC labels in the simulator built from spring.json, the reference-window network trained on
-    them, exported as a bundle whose meta records the window, k, the simulator and the control rate."""
+    them, exported as a bundle whose meta records the window, k, the simulator and the control rate. The
+    recordings in `data_paths`, if any, check that simulator (`simcheck.check_simulator`; in meta)."""
     spring = load_spring(spring_path)
+    checks = check_simulator(spring, list(data_paths))
     result = train_imitation(spring, settings)
     config = KneeConfig.from_spring(spring)
     meta = {
@@ -100,13 +104,14 @@ def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
         "control_rate_hz": settings.rate_hz,
         "simulator": {"config": config.as_dict(), "settings": list(settings.settings),
                       "effects": {s_: knee_effects(config, s_ == "ground").describe() for s_ in settings.settings}},
-        "data": [], "n_samples": int(sum(r.target_rad.size for r in result.labels)),
+        "data": data_record(list(data_paths)), "simulator_check": [c.to_dict() for c in checks],
+        "n_samples": int(sum(r.target_rad.size for r in result.labels)),
         "split": {"split": "held_out_trials", "val_every": settings.val_every},
         "training": result.summary(),
     }
     out = export_bundle(result.training.net, meta, out_dir)
     pd.DataFrame(result.training.curve).to_csv(out / "training_curve.csv", index=False)
-    return out, result
+    return out, result, checks
 
 
 def find_bundles(paths: list[str | Path]) -> list[Path]:
