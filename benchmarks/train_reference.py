@@ -5,7 +5,9 @@ training (samples/s, epochs, stop reason, wall time to the early stop: no better
 held-out trials for `patience` epochs), and the online step of the trained corrector (window buffer +
 NumPy network; and the network alone under ONNX Runtime), median over many calls.
 
-    python benchmarks/train_reference.py --spring exports/wolfgang_knee/spring.json [--calls 5000]
+    python benchmarks/train_reference.py --spring exports/wolfgang_knee/spring.json [--calls 5000] [--out DIR]
+
+`--out DIR` keeps the trained bundle (e.g. for benchmarks/closed_loop_goal.py).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from seadesign.corrector.export import NumpyCorrector, export_bundle, numpy_arra
 from seadesign.corrector.imitation import ImitationSettings, train_imitation
 from seadesign.corrector.reference import Preview
 from seadesign.corrector.runtime import ReferenceFeedForward
+from seadesign.corrector.workflow import train_reference_bundle
 from seadesign.design.spring import load_spring
 from seadesign.onnx_corrector import load_onnx
 
@@ -42,6 +45,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--spring", required=True, help="spring.json (e.g. from `seadesign sweep`)")
     ap.add_argument("--calls", type=int, default=5000)
+    ap.add_argument("--out", default=None, help="write the trained bundle here")
     args = ap.parse_args()
     spring = load_spring(args.spring)
     settings = ImitationSettings()
@@ -51,7 +55,10 @@ def main() -> None:
           f"labels: {len(settings.trials())} trials x {settings.trial_s:g} s at {settings.rate_hz:g} Hz, settings "
           f"{', '.join(settings.settings)}, k scales {settings.k_scales}; training threads {settings.train.threads}, "
           f"batch {settings.train.batch_size}, patience {settings.train.patience} epochs")
-    res = train_imitation(spring, settings)
+    if args.out:
+        _, res, _ = train_reference_bundle(args.spring, args.out, settings)
+    else:
+        res = train_imitation(spring, settings)
     steps = sum(len(r.mean_abs_error_rad) * r.target_rad.shape[0] * r.target_rad.shape[1] for r in res.labels)
     print(f"{'batch':<22} {'iterations':>10} {'best':>5} {'error_first_rad':>16} {'error_best_rad':>15}")
     for r in res.labels:

@@ -59,31 +59,10 @@ def spring_dict() -> dict:
 
 
 def thesis_spring() -> dict:
-    """The payload of `spring_dict`, for module-scoped fixtures."""
-    return {
-        "schema_version": 1,
-        "study": "wolfgang_knee",
-        "k_source": "measured",
-        "k_Nm_per_rad": 9.106,
-        "k_rel_error": None,
-        "design": {"beam_count": 9, "beam_thickness_mm": 8.0},
-        "material": {
-            "name": "ninjaflex",
-            "youngs_modulus_Pa": 12e6,
-            "poisson_ratio": 0.48,
-            "density_kg_per_m3": 1190.0,
-            "yield_strength_Pa": 4e6,
-        },
-        "actuator": {
-            "stall_torque_Nm": 11.7,
-            "no_load_speed_rad_per_s": 46 * 2 * 3.141592653589793 / 60,
-            "gear_ratio": 272.5,
-            "backlash_rad": 0.25 * 3.141592653589793 / 180,
-        },
-        "robot": {"mass_kg": 8.0, "lower_leg_m": 0.2038, "upper_leg_m": 0.2},
-        "inputs_hash": "0123456789abcdef",
-        "versions": {"seadesign": "test"},
-    }
+    """The payload of `spring_dict` (studies/thesis_measured_spring.json), for module-scoped fixtures."""
+    from seadesign.design.spring import load_spring
+
+    return load_spring(Path(__file__).resolve().parents[1] / "studies" / "thesis_measured_spring.json")
 
 
 @pytest.fixture
