@@ -75,31 +75,44 @@ class Preview:
 
 
 class ReferenceBuffer:
-    """One knee's window built online: `push` the target at each step with the preview ahead, read `features`.
+    """One knee's window built online: `features` at each step with the preview ahead.
 
     The preview arrives with each step (the walk engine's next `preview` targets and the load share
-    at t ... t+preview); past targets and load shares are kept here. Values in flexion.
+    at t ... t+preview); past targets and load shares are kept here. Values in flexion. Preallocated
+    (one control step: a few microseconds besides the network).
     """
 
     def __init__(self, window: ReferenceWindow, k_Nm_per_rad: float) -> None:
         self.window, self.k = window, float(k_Nm_per_rad)
-        self._past_t: list[float] = []
-        self._past_l: list[float] = []
+        p, f = window.past, window.preview
+        self._x = np.empty(len(window.feature_names()))
+        self._x[-1] = self.k
+        self._past_t, self._past_l = np.empty(p), np.empty(p)
+        self._started = False
+        self._rel = slice(1, 1 + p + f)
+        self._load = slice(1 + p + f, 2 + 2 * p + 2 * f)
 
     def features(self, target_rad: float, preview_rad: np.ndarray, load_share: np.ndarray) -> np.ndarray:
-        """Input vector at this step; `preview_rad` (>= 0 values, t+1 ...) and `load_share` (t, t+1, ...),
-        each padded with its last value to the window."""
-        w = self.window
-        if not self._past_t:
-            self._past_t, self._past_l = [target_rad] * w.past, [float(load_share[0]) if len(load_share) else 0.0] * w.past
-        ahead_t = np.concatenate([[target_rad], np.asarray(preview_rad, float)])
-        ahead_l = np.asarray(load_share, float) if len(load_share) else np.zeros(1)
-        ahead_t = np.pad(ahead_t[: w.preview + 1], (0, max(0, w.preview + 1 - len(ahead_t))), mode="edge")
-        ahead_l = np.pad(ahead_l[: w.preview + 1], (0, max(0, w.preview + 1 - len(ahead_l))), mode="edge")
-        tw = np.concatenate([self._past_t[len(self._past_t) - w.past:] if w.past else [], ahead_t])
-        lw = np.concatenate([self._past_l[len(self._past_l) - w.past:] if w.past else [], ahead_l])
-        if w.past:
-            self._past_t = self._past_t[1:] + [target_rad]
-            self._past_l = self._past_l[1:] + [float(ahead_l[0])]
-        rel = np.delete(tw, w.past) - target_rad
-        return np.concatenate([[target_rad], rel, lw, [self.k]])
+        """Input vector at this step; `preview_rad` (t+1 ..., up to `preview` values) and `load_share`
+        (t, t+1, ...; at least the value at t), each padded with its last value to the window. The returned
+        array is reused by the next call."""
+        p, f = self.window.past, self.window.preview
+        x = self._x
+        if not self._started:
+            self._past_t[:], self._past_l[:] = target_rad, load_share[0]
+            self._started = True
+        rel, load = x[self._rel], x[self._load]
+        rel[:p] = self._past_t
+        n = min(len(preview_rad), f)
+        rel[p: p + n] = preview_rad[:n]
+        rel[p + n:] = preview_rad[n - 1] if n else target_rad
+        rel -= target_rad
+        load[:p] = self._past_l
+        m = min(len(load_share), f + 1)
+        load[p: p + m] = load_share[:m]
+        load[p + m:] = load_share[m - 1]
+        x[0] = target_rad
+        if p:
+            self._past_t[:-1], self._past_t[-1] = self._past_t[1:], target_rad
+            self._past_l[:-1], self._past_l[-1] = self._past_l[1:], load_share[0]
+        return x
