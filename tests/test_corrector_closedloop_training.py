@@ -11,10 +11,10 @@ from conftest import thesis_spring
 
 from seadesign.corrector.closedloop import closed_loop_table, run_closed_loop
 from seadesign.corrector.closedloop_training import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, ClosedLoopCorrector,
-                                                     ClosedLoopPolicy, ClosedLoopSettings, measured_inputs,
-                                                     train_closed_loop)
+                                                     ClosedLoopPolicy, ClosedLoopSettings, WindowBuffer,
+                                                     measured_inputs, train_closed_loop)
 from seadesign.corrector.goal import goal_table
-from seadesign.corrector.reference import Preview, ReferenceWindow, reference_features
+from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, reference_features
 from seadesign.corrector.runtime import FeedForward, HallPI, NoCorrection
 from seadesign.errors import SeadesignError
 from seadesign.twin import KneeConfig, Trial, configure_chain, knee_effects
@@ -98,6 +98,20 @@ def test_runtime_is_the_policy_and_mirrors_the_right_knee():
         assert right == pytest.approx(-left, abs=1e-12)
     with pytest.raises(SeadesignError, match="preview"):
         runtime.command("left", 1.0, {"hall_pos_rad": 1.0, "hall_vel_rad_per_s": 0.0}, 0.01)
+
+
+@pytest.mark.parametrize("past,preview", [(5, 10), (0, 3), (4, 0)])
+def test_window_buffer_gives_the_reference_buffers_features(past, preview):
+    """The runtime's preallocated buffer equals `ReferenceBuffer` step by step, with previews cut short at a
+    trial's end (or longer than the window) and missing load shares."""
+    rng = np.random.default_rng(past + preview)
+    window = ReferenceWindow(past, preview)
+    ref, fast = ReferenceBuffer(window, 7.5), WindowBuffer(window, 7.5)
+    target, load = np.cumsum(rng.normal(size=40)), rng.uniform(size=40)
+    for t in range(40):
+        ahead = target[t + 1: t + 1 + preview + t % 3]
+        share = load[t: t + 1 + preview] if t % 5 else load[:0]
+        np.testing.assert_array_equal(fast.features(target[t], ahead, share), ref.features(target[t], ahead, share))
 
 
 def test_gradient_reaches_both_branches_through_the_torch_knee(spring_dict):
