@@ -47,7 +47,8 @@ SPRING = {
     "robot": {"mass_kg": 8.0, "lower_leg_m": 0.2038, "upper_leg_m": 0.2},
     "inputs_hash": "0123456789abcdef", "versions": {"seadesign": __version__},
 }
-CASES = {"nominal": {}, "gait 0.7 s": {"gait": Gait(cycle_s=0.7)}, "k x0.7": {"k_scale": 0.7}, "k x1.4": {"k_scale": 1.4}}
+CASES = {"nominal": {}, "gait 0.7 s": {"gait": Gait(cycle_s=0.7)}, "k x0.7": {"k_scale": 0.7},
+         "k x1.4": {"k_scale": 1.4}}
 
 
 def _latency_us(corrector, calls: int) -> float:

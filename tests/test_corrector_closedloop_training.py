@@ -11,8 +11,8 @@ from conftest import thesis_spring
 
 from seadesign.corrector.closedloop import closed_loop_table, run_closed_loop
 from seadesign.corrector.closedloop_training import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, ClosedLoopCorrector,
-                                                     ClosedLoopPolicy, ClosedLoopSettings, WindowBuffer,
-                                                     measured_inputs, train_closed_loop)
+                                                     ClosedLoopPolicy, ClosedLoopSettings, FeedbackBranch, WindowBuffer,
+                                                     train_closed_loop, window_policy)
 from seadesign.corrector.goal import goal_table
 from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, reference_features
 from seadesign.corrector.runtime import FeedForward, HallPI, NoCorrection
@@ -22,6 +22,7 @@ from seadesign.twin.knee import SIGN
 from seadesign.twin.torch_knee import TorchKnee, protocol_tensors, rollout
 
 WINDOW = ReferenceWindow()
+QUIET = ["hall_noise=off", "hall_quantisation=off", "motor_quantisation=off", "effort_noise=off"]
 
 
 @pytest.fixture(autouse=True)
@@ -63,17 +64,23 @@ def test_feedback_gain_is_bounded_and_zero_at_zero_error():
         np.testing.assert_allclose(policy(x, torch.zeros_like(m)).numpy(), policy.ff(x).numpy(), atol=1e-6)
 
 
-def test_feedback_bound_is_reached_by_aligned_weights_and_not_passed():
-    """One tanh layer, no reference context, raw weights 5 e1 e1^T and 5 e1^T: unbounded, the gain at m = 0 would
-    be 25 L; bounded it is exactly L there, and below L elsewhere (tanh' <= 1)."""
-    policy, X = _policy()
-    policy.feedback = type(policy.feedback)(len(WINDOW.feature_names()), hidden=8, layers=1)
+def _aligned_feedback(policy: ClosedLoopPolicy) -> None:
+    """Give `policy` a one-layer feedback without reference context, raw weights 5 e1 e1^T and 5 e1^T: its gain is
+    L along the Hall error at m = 0 (25 L without the bound)."""
+    policy.feedback = FeedbackBranch(len(WINDOW.feature_names()), hidden=8, layers=1)
     fb = policy.feedback
     with torch.no_grad():
         fb.x_in.weight.zero_()
         fb.x_in.bias.zero_()
         fb.m_in.parametrizations.weight.original.copy_(5.0 * torch.eye(8, 2))
         fb.out.parametrizations.weight.original.copy_(5.0 * torch.eye(1, 8))
+
+
+def test_feedback_bound_is_reached_by_aligned_weights_and_not_passed():
+    """One tanh layer, no reference context, raw weights 5 e1 e1^T and 5 e1^T: unbounded, the gain at m = 0 would
+    be 25 L; bounded it is exactly L there, and below L elsewhere (tanh' <= 1)."""
+    policy, X = _policy()
+    _aligned_feedback(policy)
     x = torch.as_tensor(X[:64], dtype=torch.float32)
     at_zero = _gains(policy, x, torch.zeros(64, 2))
     np.testing.assert_allclose(at_zero.numpy(), FEEDBACK_LIPSCHITZ_RAD_PER_RAD, rtol=1e-6)
@@ -114,30 +121,66 @@ def test_window_buffer_gives_the_reference_buffers_features(past, preview):
         np.testing.assert_array_equal(fast.features(target[t], ahead, share), ref.features(target[t], ahead, share))
 
 
+def _walk(spring: dict, trials: list[Trial]) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Targets, stances (trials, steps, 2) on the ground and the reference features (trials, steps, 2, d)."""
+    _, target, stance = protocol_tensors(trials)
+    feats = reference_features(np.moveaxis(target.numpy(), 2, 1), np.moveaxis(stance.numpy(), 2, 1),
+                               spring["k_Nm_per_rad"], WINDOW)
+    return target, stance, torch.as_tensor(np.moveaxis(feats, 1, 2), dtype=torch.float32)
+
+
 def test_gradient_reaches_both_branches_through_the_torch_knee(spring_dict):
     """The mean squared Hall error of a 30-sample rollout on the ground (noise on) has finite, nonzero gradients
     for the feed-forward and the feedback parameters."""
     policy, _ = _policy(seed=5, spread=0.2)
     cfg = KneeConfig.from_spring(spring_dict)
     knee = TorchKnee(cfg, knee_effects(cfg, ground=True), noise=True)
-    _, target, stance = protocol_tensors([Trial("front", 0.15, 2.0), Trial("back_right", 0.1, 2.0)])
-    feats = reference_features(np.moveaxis(target.numpy(), 2, 1), np.moveaxis(stance.numpy(), 2, 1),
-                               spring_dict["k_Nm_per_rad"], WINDOW)
-    x = torch.as_tensor(np.moveaxis(feats, 1, 2), dtype=torch.float32)
+    target, stance, x = _walk(spring_dict, [Trial("front", 0.15, 2.0), Trial("back_right", 0.1, 2.0)])
     knee.reset(target[:, 0], stance[:, 0])
     with torch.no_grad():
         rollout(knee, lambda obs, k: target[:, k], stance, 120)  # into the walk
-
-    def act(obs, k):
-        m = measured_inputs(target[:, k], target[:, k - 1], obs.hall_rad, obs.hall_velocity_rad_per_s, knee.dt)
-        return policy(x[:, k], m.float()).double()
-
-    out = rollout(knee, act, stance, 30)
+    out = rollout(knee, window_policy(policy, x, target, 120, 30, knee.dt), stance, 30)
     ((out["hall_rad"] - target[:, 120:150]) ** 2).mean().backward()
     for branch in (policy.ff, policy.feedback):
         grads = [p.grad for p in branch.parameters() if p.requires_grad]
         assert all(g is not None and torch.isfinite(g).all() for g in grads)
         assert sum(float(g.abs().sum()) for g in grads) > 0
+
+
+def test_gradient_through_the_loop_matches_finite_differences(spring_dict):
+    """d loss / d (feedback output weights) along a random direction, autograd against a central difference
+    (float64, no noise or quantisation): the gradient includes the path through the measured Hall reading
+    back into the feedback (cutting that path moves it by 1 %; measured agreement 7e-7 relative)."""
+    policy, _ = _policy(seed=7, spread=0.5)
+    _aligned_feedback(policy)
+    policy.double()
+    cfg = KneeConfig.from_spring(spring_dict)
+    chain = configure_chain(knee_effects(cfg, ground=True), QUIET)
+    target, stance, x = _walk(spring_dict, [Trial("front", 0.15, 2.0)])
+    knee = TorchKnee(cfg, chain)
+    knee.reset(target[:, 0], stance[:, 0])
+    with torch.no_grad():
+        rollout(knee, lambda obs, k: target[:, k], stance, 110)
+    start = knee.state()
+    weight = policy.feedback.m_in.parametrizations.weight.original
+    direction = torch.randn(weight.shape, generator=torch.Generator().manual_seed(8), dtype=torch.float64)
+
+    def loss() -> torch.Tensor:
+        knee.load_state(start)
+        out = rollout(knee, window_policy(policy, x, target, 110, 40, knee.dt), stance, 40)
+        return ((out["hall_rad"] - target[:, 110:150]) ** 2).mean()
+
+    analytic = float(torch.autograd.grad(loss(), weight)[0].flatten() @ direction.flatten())
+    eps = 1e-5
+    with torch.no_grad():
+        weight += eps * direction
+        up = float(loss())
+        weight -= 2 * eps * direction
+        down = float(loss())
+        weight += eps * direction
+    numeric = (up - down) / (2 * eps)
+    assert abs(numeric) > 1e-3
+    assert analytic == pytest.approx(numeric, rel=1e-5)
 
 
 def test_runtime_in_the_simulator_follows_the_policy_in_the_torch_knee(spring_dict):
@@ -148,25 +191,15 @@ def test_runtime_in_the_simulator_follows_the_policy_in_the_torch_knee(spring_di
     policy, _ = _policy(seed=6, spread=0.3)
     trials = [Trial("front", 0.15, 3.0), Trial("back_right", 0.1, 3.0)]
     cfg = KneeConfig.from_spring(spring_dict)
-    chain = configure_chain(knee_effects(cfg, ground=True),
-                            ["hall_noise=off", "hall_quantisation=off", "motor_quantisation=off", "effort_noise=off"])
+    chain = configure_chain(knee_effects(cfg, ground=True), QUIET)
     run = run_closed_loop(ClosedLoopCorrector(policy, spring_dict["k_Nm_per_rad"]), spring_dict, trials, ground=True,
                           effects=chain)
     assert not run.unstable
-    _, target, stance = protocol_tensors(trials)
-    feats = reference_features(np.moveaxis(target.numpy(), 2, 1), np.moveaxis(stance.numpy(), 2, 1),
-                               spring_dict["k_Nm_per_rad"], WINDOW)
-    x = torch.as_tensor(np.moveaxis(feats, 1, 2), dtype=torch.float32)
+    target, stance, x = _walk(spring_dict, trials)
     knee = TorchKnee(cfg, chain)
     knee.reset(target[:, 0], stance[:, 0])
-
-    def act(obs, k):
-        m = measured_inputs(target[:, k], target[:, max(k - 1, 0)], obs.hall_rad, obs.hall_velocity_rad_per_s,
-                            knee.dt)
-        return policy(x[:, k], m.float()).double()
-
     with torch.no_grad():
-        out = rollout(knee, act, stance, target.shape[1])
+        out = rollout(knee, window_policy(policy, x, target, 0, target.shape[1], knee.dt), stance, target.shape[1])
     np.testing.assert_allclose(run.command * SIGN, out["command_rad"].numpy(), atol=2e-5)
     np.testing.assert_allclose(run.hall * SIGN, out["hall_rad"].numpy(), atol=2e-5)
     assert np.abs(run.command * SIGN - target.numpy()).max() > 0.05  # the policy does correct

@@ -64,7 +64,7 @@ from seadesign.data import KNEE_SIGN_BY_NAME
 from seadesign.errors import SeadesignError
 from seadesign.twin import Trial
 from seadesign.twin.config import KneeConfig, knee_effects
-from seadesign.twin.torch_knee import TorchKnee, protocol_tensors, rollout
+from seadesign.twin.torch_knee import Policy, TorchKnee, TorchObservation, protocol_tensors, rollout
 from seadesign.twin.walk import DIRECTIONS, Gait
 
 #: bound on the feedback's Lipschitz constant w.r.t. m (rad/rad); see the module docstring
@@ -142,7 +142,8 @@ class ClosedLoopPolicy(nn.Module):
         self.feedback = FeedbackBranch(d, hidden, layers)
 
     @classmethod
-    def from_scratch(cls, features: np.ndarray, window: ReferenceWindow, seed: int = 0, **options: Any) -> "ClosedLoopPolicy":
+    def from_scratch(cls, features: np.ndarray, window: ReferenceWindow, seed: int = 0,
+                     **options: Any) -> "ClosedLoopPolicy":
         """A policy whose feed-forward starts at command = target (plus a small random correction), normalised on
         `features` (N, d) (the training inputs); hidden 3 x 64 leaky ReLU as family 1."""
         torch.manual_seed(seed)
@@ -286,20 +287,24 @@ def _batch(spring: dict, s: ClosedLoopSettings) -> _Batch:
                   rows[~is_val], rows[is_val])
 
 
-def _act(policy: ClosedLoopPolicy, b: _Batch, k0: int, n_steps: int):
-    """The policy as a `rollout` policy over samples k0 ... k0 + n_steps - 1 (feed-forward and the feedback's
-    reference context evaluated for the whole window at once)."""
-    x = b.features[:, k0: k0 + n_steps]
-    ff = policy.ff(x).double()
+def window_policy(policy: ClosedLoopPolicy, features: torch.Tensor, target_rad: torch.Tensor, k0: int,
+                  n_steps: int, dt_s: float) -> Policy:
+    """The policy as a `torch_knee.rollout` policy over samples k0 ... k0 + n_steps - 1 of trajectories with
+    reference features (trials, steps, 2, d) and flexion targets (trials, steps, 2) rad; the feed-forward and the
+    feedback's reference context are evaluated for the whole window at once. Commands in the targets' dtype."""
+    dtype = policy.ff.x_mean.dtype
+    x = features[:, k0: k0 + n_steps].to(dtype)
+    ff = policy.ff(x)
     ctx = policy.feedback.context(policy.ff.normalise(x))
-    h0 = policy.feedback.from_context(torch.zeros(*x.shape[:-1], 2), ctx).double()
-    dt, scale = b.knee.dt, policy.lipschitz_rad_per_rad
+    h0 = policy.feedback.from_context(torch.zeros(*x.shape[:-1], 2, dtype=dtype), ctx)
+    scale, out = policy.lipschitz_rad_per_rad, target_rad.dtype
 
-    def act(obs, k: int) -> torch.Tensor:
+    def act(obs: TorchObservation, k: int) -> torch.Tensor:
         j = k - k0
-        m = measured_inputs(b.target[:, k], b.target[:, max(k - 1, 0)], obs.hall_rad,
-                            obs.hall_velocity_rad_per_s, dt)
-        return ff[:, j] + scale * (policy.feedback.from_context(m.float(), ctx[:, j]).double() - h0[:, j])
+        m = measured_inputs(target_rad[:, k], target_rad[:, max(k - 1, 0)], obs.hall_rad,
+                            obs.hall_velocity_rad_per_s, dt_s)
+        fb = policy.feedback.from_context(m.to(dtype), ctx[:, j]).to(out) - h0[:, j].to(out)
+        return ff[:, j].to(out) + scale * fb
 
     return act
 
@@ -321,7 +326,7 @@ def _record(policy: ClosedLoopPolicy, b: _Batch, window_steps: int) -> tuple[lis
         for k0 in range(0, n, window_steps):
             starts.append(b.knee.state())
             w = min(window_steps, n - k0)
-            out = rollout(b.knee, _act(policy, b, k0, w), b.stance, w)
+            out = rollout(b.knee, window_policy(policy, b.features, b.target, k0, w, b.knee.dt), b.stance, w)
             hall.append(out["hall_rad"])
             cmd.append(out["command_rad"])
     return starts, {"hall": torch.cat(hall, 1).numpy(), "command": torch.cat(cmd, 1).numpy()}
@@ -390,7 +395,8 @@ def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> Cl
             b.knee.load_state(starts[w])
             opt.zero_grad(set_to_none=True)
             with parametrize.cached():
-                out = rollout(b.knee, _act(policy, b, k0, steps), b.stance, steps)
+                out = rollout(b.knee, window_policy(policy, b.features, b.target, k0, steps, b.knee.dt), b.stance,
+                              steps)
                 loss = _window_loss(out, b.target[:, k0: k0 + steps], b.train_rows, b.knee.dt, s.rate_weight_s2)
                 loss.backward()
             nn.utils.clip_grad_norm_(policy.parameters(), s.grad_clip)
@@ -450,8 +456,8 @@ class WindowBuffer:
 
 
 class ClosedLoopCorrector:
-    """The trained policy in NumPy (float64) for `run_closed_loop`: reference window (`WindowBuffer`) from the walk engine's
-    preview, Hall error and its rate from `measured` (robot frame in and out, the right knee mirrored).
+    """The trained policy in NumPy (float64) for `run_closed_loop`: reference window (`WindowBuffer`) from the
+    walk engine's preview, Hall error and its rate from `measured` (robot frame in and out, the right knee mirrored).
     `k_Nm_per_rad`: the spring's stiffness from spring.json (a reference-window input). The input
     standardisation is folded into the first layers, and the feed-forward's and the feedback's first layers
     on the window are one matrix."""
