@@ -116,11 +116,12 @@ def main() -> None:
     runs = {"scratch": (base, None)}
     if family1 is not None:
         runs["fine-tuned"] = (dataclasses.replace(base, lr=1e-3), family1)
+    knees = len(base.directions) * (len(base.speeds) + len(base.val_speeds)) * len(base.settings) * 2
     print(f"settings: {len(base.directions)} directions x speeds {base.speeds} (training) and {base.val_speeds} "
           f"(validation), {base.trial_s:g} s trials, {' and '.join(base.settings)}, noise on, float64 knee; windows "
           f"of {base.window_steps} samples, feedback Lipschitz bound {base.lipschitz_rad_per_rad} rad/rad, command-"
           f"rate weight {base.rate_weight_s2:g} s^2; stop: < {base.min_improvement:.0%} for {base.patience} epochs "
-          f"(cap {base.max_seconds:g} s); threads {args.threads}")
+          f"(cap {base.max_seconds:g} s); threads {args.threads}; batch {knees} knees (steps/s: samples of the batch)")
     print(f"{'run':<11} {'lr':>6} {'epochs':>6} {'best':>5} {'stop':>10} {'wall_s':>7} {'steps/s':>8} "
           f"{'bptt steps/s':>12} {'val_err_rad':>11} {'L_bound':>7} {'step_us':>7}")
     correctors, names = [], []

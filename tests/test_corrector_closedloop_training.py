@@ -228,25 +228,29 @@ def test_settings_refuse_overlapping_speeds_and_a_wrong_window():
         ClosedLoopPolicy.from_feedforward(policy.ff, ReferenceWindow(past=2, preview=3))
 
 
-#: slow test thresholds, a few times the measured margin (run of `SLOW`, filled from the measurement below)
+#: 8 epochs from scratch, fixed (so the result does not depend on the machine's speed)
 SLOW = ClosedLoopSettings(max_epochs=8, max_seconds=float("inf"))
 
 
 @pytest.mark.slow
 def test_family2_from_scratch_meets_the_closed_loop_goal_in_every_cell():
-    """Trained from scratch for 8 epochs (fixed, so the result does not depend on the machine's speed), the
-    corrector meets the goal in all 36 cells of the thesis protocol (18 trials x hanging / ground) against none,
-    PI and the k-feed-forward in the NumPy simulator, with no unstable or oscillating flag."""
+    """The corrector trained for `SLOW` meets the goal in all 36 cells of the thesis protocol (18 trials x hanging /
+    ground) against none, PI and the k-feed-forward in the NumPy simulator, with no unstable or oscillating flag.
+    Measured: smallest gain 0.880 hanging, 0.774 ground (goal 0.30); mean |Hall error| 0.0129 rad hanging, 0.0637 rad ground; rest
+    chatter 0.0013 rad (flag 0.02); feedback bound 0.450 rad/rad. The thresholds leave a few times the
+    measured margin."""
     spring = thesis_spring()
     k = spring["k_Nm_per_rad"]
     res = train_closed_loop(spring, SLOW)
     corrector = ClosedLoopCorrector(res.policy, k, name="family2")
-    runs, tables = {}, []
+    runs, rows = {}, {}
     for setting in ("hanging", "ground"):
         table, runs[setting] = closed_loop_table([NoCorrection(), HallPI(), FeedForward(k), corrector], spring,
                                                  (setting,))
-        tables.append(table.set_index("candidate").loc["family2"])
+        rows[setting] = table.set_index("candidate").loc["family2"]
     goal = goal_table(runs, "family2")
-    print(goal.groupby("setting").gain.describe(), [t.mean_abs_error_rad for t in tables],
-          [t.rest_chatter_rms_max_rad for t in tables], res.policy.feedback_lipschitz_bound())
     assert len(goal) == 36 and goal.meets_goal.all() and not goal.flagged.any()
+    assert goal.gain.min() >= 0.6
+    assert rows["hanging"].mean_abs_error_rad < 0.02 and rows["ground"].mean_abs_error_rad < 0.08
+    assert max(r.rest_chatter_rms_max_rad for r in rows.values()) < 0.005
+    assert res.policy.feedback_lipschitz_bound() <= 0.5 + 1e-6  # the stated design bound, rad/rad
