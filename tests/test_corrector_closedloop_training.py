@@ -11,7 +11,7 @@ from conftest import thesis_spring
 
 from seadesign.corrector.closedloop import closed_loop_table, run_closed_loop
 from seadesign.corrector.closedloop_training import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, ClosedLoopCorrector,
-                                                     ClosedLoopPolicy, ClosedLoopSettings, FeedbackBranch, WindowBuffer,
+                                                     ClosedLoopPolicy, ClosedLoopSettings, FeedbackBranch,
                                                      train_closed_loop, window_policy)
 from seadesign.corrector.goal import goal_table
 from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, reference_features
@@ -108,17 +108,20 @@ def test_runtime_is_the_policy_and_mirrors_the_right_knee():
 
 
 @pytest.mark.parametrize("past,preview", [(5, 10), (0, 3), (4, 0)])
-def test_window_buffer_gives_the_reference_buffers_features(past, preview):
-    """The runtime's preallocated buffer equals `ReferenceBuffer` step by step, with previews cut short at a
-    trial's end (or longer than the window) and missing load shares."""
+def test_reference_buffer_cuts_long_previews_and_reads_missing_load_as_none(past, preview):
+    """The online buffer with previews longer than its window gives the rows of the exact window (the offline
+    features); with no load share given, its load columns are 0."""
     rng = np.random.default_rng(past + preview)
     window = ReferenceWindow(past, preview)
-    ref, fast = ReferenceBuffer(window, 7.5), WindowBuffer(window, 7.5)
     target, load = np.cumsum(rng.normal(size=40)), rng.uniform(size=40)
+    offline = reference_features(target, load, 7.5, window)
+    buf, bare = ReferenceBuffer(window, 7.5), ReferenceBuffer(window, 7.5)
+    loads = [n for n in window.feature_names() if n.startswith("load_share")]
+    cols = [window.feature_names().index(n) for n in loads]
     for t in range(40):
-        ahead = target[t + 1: t + 1 + preview + t % 3]
-        share = load[t: t + 1 + preview] if t % 5 != 3 else load[:0]
-        np.testing.assert_array_equal(fast.features(target[t], ahead, share), ref.features(target[t], ahead, share))
+        ahead = target[t + 1: t + 1 + preview + 3]
+        np.testing.assert_array_equal(buf.features(target[t], ahead, load[t: t + 4 + preview]), offline[t])
+        np.testing.assert_array_equal(bare.features(target[t], ahead, load[:0])[cols], 0.0)
 
 
 def _walk(spring: dict, trials: list[Trial]) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:

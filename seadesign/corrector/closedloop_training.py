@@ -63,7 +63,7 @@ from seadesign.corrector.dataset import KNEES
 from seadesign.corrector.export import LEAKY_SLOPE
 from seadesign.corrector.imitation import TRAIN_SPEEDS
 from seadesign.corrector.models import CorrectorNet, MLPCore
-from seadesign.corrector.reference import Preview, ReferenceWindow, reference_features
+from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, reference_features
 from seadesign.data import KNEE_SIGN_BY_NAME
 from seadesign.errors import SeadesignError
 from seadesign.twin import Trial
@@ -419,48 +419,8 @@ def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> Cl
 
 
 # -- runtime -------------------------------------------------------------------------------------------------
-class WindowBuffer:
-    """`reference.ReferenceBuffer`'s features (the same vector, step by step) from preallocated arrays, for a
-    control step well under 50 us: past targets and load shares kept here, the preview (t+1 ... targets, rad;
-    t, t+1 ... load shares) padded with its last value, in flexion."""
-
-    def __init__(self, window: ReferenceWindow, k_Nm_per_rad: float) -> None:
-        self.past, self.preview = window.past, window.preview
-        self._row = np.empty(len(window.feature_names()))
-        self._row[-1] = float(k_Nm_per_rad)
-        self._t = np.empty(self.past)  # past targets, oldest first
-        self._l = np.empty(self.past)
-        self._started = False
-
-    def features(self, target_rad: float, preview_rad: np.ndarray, load_share: np.ndarray) -> np.ndarray:
-        """Input vector at this step (a view into the buffer's row: use it before the next call)."""
-        p, a = self.past, self.preview
-        ahead_t = np.empty(a + 1)
-        ahead_t[0] = target_rad
-        given = min(len(preview_rad), a)
-        ahead_t[1: 1 + given] = preview_rad[:given]
-        ahead_t[1 + given:] = ahead_t[given]
-        ahead_l = np.zeros(a + 1)
-        given = min(len(load_share), a + 1)
-        if given:
-            ahead_l[:given] = load_share[:given]
-            ahead_l[given:] = ahead_l[given - 1]
-        if not self._started:
-            self._t[:], self._l[:], self._started = target_rad, ahead_l[0], True
-        row = self._row
-        row[0] = target_rad
-        row[1: 1 + p] = self._t - target_rad
-        row[1 + p: 1 + p + a] = ahead_t[1:] - target_rad
-        row[1 + p + a: 1 + 2 * p + a] = self._l
-        row[1 + 2 * p + a: -1] = ahead_l
-        if p:
-            self._t[:-1], self._t[-1] = self._t[1:], target_rad
-            self._l[:-1], self._l[-1] = self._l[1:], ahead_l[0]
-        return row
-
-
 class ClosedLoopCorrector:
-    """The trained policy in NumPy (float64) for `run_closed_loop`: reference window (`WindowBuffer`) from the
+    """The trained policy in NumPy (float64) for `run_closed_loop`: reference window (`reference.ReferenceBuffer`) from the
     walk engine's preview, Hall error and its rate from `measured` (robot frame in and out, the right knee mirrored).
     `k_Nm_per_rad`: the spring's stiffness from spring.json (a reference-window input). The input
     standardisation is folded into the first layers, and the feed-forward's and the feedback's first layers
@@ -489,7 +449,7 @@ class ClosedLoopCorrector:
         self.reset()
 
     def reset(self) -> None:
-        self._buffers = {k: WindowBuffer(self.window, self.k) for k in KNEES}
+        self._buffers = {k: ReferenceBuffer(self.window, self.k) for k in KNEES}
         self._prev_target: dict[str, float | None] = {k: None for k in KNEES}
 
     def policy_command(self, x: np.ndarray, m: np.ndarray) -> float:

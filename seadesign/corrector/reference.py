@@ -74,6 +74,9 @@ class Preview:
     load_share: np.ndarray
 
 
+_NO_LOAD = np.zeros(1)
+
+
 class ReferenceBuffer:
     """One knee's window built online: `features` at each step with the preview ahead.
 
@@ -93,11 +96,13 @@ class ReferenceBuffer:
         self._load = slice(1 + p + f, 2 + 2 * p + 2 * f)
 
     def features(self, target_rad: float, preview_rad: np.ndarray, load_share: np.ndarray) -> np.ndarray:
-        """Input vector at this step; `preview_rad` (t+1 ..., up to `preview` values) and `load_share`
-        (t, t+1, ...; at least the value at t), each padded with its last value to the window. The returned
+        """Input vector at this step; `preview_rad` (t+1 ..., up to `preview` values used) and `load_share`
+        (t, t+1, ...; none: 0, no load known), each padded with its last value to the window. The returned
         array is reused by the next call."""
         p, f = self.window.past, self.window.preview
         x = self._x
+        if not len(load_share):
+            load_share = _NO_LOAD
         if not self._started:
             self._past_t[:], self._past_l[:] = target_rad, load_share[0]
             self._started = True
