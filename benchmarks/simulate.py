@@ -11,22 +11,15 @@ import argparse
 import os
 import platform
 import time
+from pathlib import Path
 
 import numpy as np
 
 from seadesign import __version__
+from seadesign.design.spring import load_spring
 from seadesign.twin import KneeSession, thesis_protocol
 
-SPRING = {
-    "schema_version": 1, "study": "benchmark", "k_source": "measured", "k_Nm_per_rad": 9.106, "k_rel_error": None,
-    "design": {"beam_count": 9, "beam_thickness_mm": 8.0},
-    "material": {"name": "ninjaflex", "youngs_modulus_Pa": 12e6, "poisson_ratio": 0.48,
-                 "density_kg_per_m3": 1190.0, "yield_strength_Pa": 4e6},
-    "actuator": {"stall_torque_Nm": 11.7, "no_load_speed_rad_per_s": 46 * 2 * np.pi / 60, "gear_ratio": 272.5,
-                 "backlash_rad": np.deg2rad(0.25)},
-    "robot": {"mass_kg": 8.0, "lower_leg_m": 0.2038, "upper_leg_m": 0.2},
-    "inputs_hash": "0123456789abcdef", "versions": {"seadesign": __version__},
-}
+SPRING = load_spring(Path(__file__).resolve().parents[1] / "studies" / "thesis_measured_spring.json")
 
 
 def main() -> None:

@@ -63,7 +63,7 @@ from seadesign.corrector.dataset import KNEES
 from seadesign.corrector.export import LEAKY_SLOPE
 from seadesign.corrector.imitation import TRAIN_SPEEDS
 from seadesign.corrector.models import CorrectorNet, MLPCore
-from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, reference_features
+from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, knee_window, reference_features
 from seadesign.data import KNEE_SIGN_BY_NAME
 from seadesign.errors import SeadesignError
 from seadesign.twin import Trial
@@ -468,13 +468,9 @@ class ClosedLoopCorrector:
 
     def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float,
                 preview: Preview | None = None) -> float:
-        if preview is None:
-            raise SeadesignError(f"corrector '{self.name}' needs the walk engine's preview of "
-                                 f"{self.preview_steps} steps; drive it through the closed loop")
         sign = KNEE_SIGN_BY_NAME[knee]
-        target = sign * target_rad
+        target, x = knee_window(self._buffers[knee], sign, target_rad, preview, self.name)
         prev = self._prev_target[knee]
         self._prev_target[knee] = target
-        x = self._buffers[knee].features(target, sign * np.asarray(preview.target_rad), preview.load_share)
         rate = (0.0 if prev is None else (target - prev) / dt_s) - sign * measured["hall_vel_rad_per_s"]
         return sign * self.policy_command(x, np.array([target - sign * measured["hall_pos_rad"], RATE_TIME_S * rate]))

@@ -121,3 +121,14 @@ class ReferenceBuffer:
             self._past_t[:-1], self._past_t[-1] = self._past_t[1:], target_rad
             self._past_l[:-1], self._past_l[-1] = self._past_l[1:], load_share[0]
         return x
+
+
+def knee_window(buffer: ReferenceBuffer, sign: float, target_rad: float, preview: Preview | None,
+                name: str) -> tuple[float, np.ndarray]:
+    """A corrector's step in flexion: the target (rad, robot frame x `sign`) and the window's features from the
+    walk engine's `preview` (robot frame); a clear error naming corrector `name` when there is none."""
+    if preview is None:
+        raise SeadesignError(f"corrector '{name}' needs the walk engine's preview of {buffer.window.preview} "
+                             "steps; drive it through the closed loop")
+    target = sign * target_rad
+    return target, buffer.features(target, sign * np.asarray(preview.target_rad), preview.load_share)

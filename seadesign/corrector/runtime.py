@@ -25,7 +25,7 @@ import numpy as np
 
 from seadesign.corrector.dataset import KNEES, DatasetSpec, FeatureBuilder
 from seadesign.corrector.export import NumpyCorrector
-from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow
+from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, knee_window
 from seadesign.data import KNEE_SIGN_BY_NAME
 from seadesign.design.spring import TorqueCurve
 from seadesign.errors import SeadesignError
@@ -134,12 +134,8 @@ class ReferenceFeedForward:
 
     def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float,
                 preview: Preview | None = None) -> float:
-        if preview is None:
-            raise SeadesignError(f"corrector '{self.name}' needs the walk engine's preview of "
-                                 f"{self.preview_steps} steps; drive it through the closed loop")
         sign = KNEE_SIGN_BY_NAME[knee]
-        target = sign * target_rad
-        x = self._buffers[knee].features(target, sign * np.asarray(preview.target_rad), preview.load_share)
+        target, x = knee_window(self._buffers[knee], sign, target_rad, preview, self.name)
         e = target - sign * measured["hall_pos_rad"]
         self._integral[knee] += e * dt_s
         return sign * (float(self.model(x)) + self.kp * e + self.ki * self._integral[knee])
