@@ -208,7 +208,7 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
         spring = load_spring(spring_file)  # a clear error when it is gone: the simulator needs it
         trials = thesis_protocol(trial_s)
         cl_table, _ = closed_loop_table(correctors, spring, closed_loop, trials, seed=seed)
-        gains = loop_gain_table([c for c in correctors], spring, closed_loop, trials, seed=seed)
+        gains = loop_gain_table(correctors, spring, closed_loop, trials, seed=seed)
         cl_table = cl_table.merge(gains, on=["candidate", "setting"], how="left")
         cl_table["stable"] = ~(cl_table.unstable_flag.astype(bool) | cl_table.oscillating_flag.astype(bool)
                                | cl_table.loop_gain_flag.astype(bool))
