@@ -64,7 +64,8 @@ class ClosedLoopRun:
     recording: pd.DataFrame | None = None  # robot-format table of the samples run (all, or those before a stop)
 
 
-def _needs_aux(corrector: Corrector) -> bool:
+def needs_aux(corrector: Corrector) -> bool:
+    """True for a corrector that reads IMU or foot-pressure channels (the knee simulator has none)."""
     spec = getattr(corrector, "spec", None)
     return spec is not None and any(m in ("imu", "pressure") for m in spec.modalities)
 
@@ -75,7 +76,7 @@ class Driver:
     next targets and load share."""
 
     def __init__(self, corrector: Corrector, sim: KneeSession) -> None:
-        if _needs_aux(corrector):
+        if needs_aux(corrector):
             raise SeadesignError(f"corrector '{corrector.name}' needs IMU/foot-pressure inputs, which the knee "
                                  "simulator does not observe; train it on knee channels only for closed-loop use")
         self.sim, self.copies = sim, []
@@ -182,7 +183,7 @@ def closed_loop_table(correctors: list[Corrector], spring: dict[str, Any], setti
         if setting not in ("hanging", "ground"):
             raise SeadesignError(f"unknown closed-loop setting '{setting}'; use hanging or ground")
         for c in correctors:
-            if _needs_aux(c):
+            if needs_aux(c):
                 rows.append({"candidate": c.name, "setting": setting, "note": "not run: needs IMU/pressure inputs"})
                 continue
             run = run_closed_loop(c, spring, trials, ground=setting == "ground", rate_hz=rate_hz, seed=seed, **session)

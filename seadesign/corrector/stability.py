@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 from scipy.signal import csd, welch
 
-from seadesign.corrector.closedloop import Driver
+from seadesign.corrector.closedloop import Driver, needs_aux
 from seadesign.corrector.ilc import NOISE_EFFECTS
 from seadesign.corrector.runtime import Corrector
 from seadesign.effects import effect_rng
@@ -111,8 +111,9 @@ def measure_loop_gain(corrector: Corrector, spring: dict[str, Any], trials: list
 
 def loop_gain_table(correctors: list[Corrector], spring: dict[str, Any], settings: tuple[str, ...],
                     trials: list[Trial], rate_hz: float = 100.0, seed: int = 0) -> pd.DataFrame:
-    """One row per corrector and setting: modulus margin, its frequency and coherence, crossover gain, flag."""
+    """One row per corrector and setting: modulus margin, its frequency and coherence, crossover gain, flag
+    (correctors that need IMU or foot-pressure inputs, which the simulator lacks, are left out)."""
     rows = [{"candidate": c.name, "setting": setting,
              **measure_loop_gain(c, spring, trials, setting == "ground", rate_hz, seed).row()}
-            for setting in settings for c in correctors]
+            for setting in settings for c in correctors if not needs_aux(c)]
     return pd.DataFrame(rows)
