@@ -89,7 +89,7 @@ def test_default_train_meets_the_closed_loop_goal_on_unseen_trajectories_and_rob
         assert keeps.all(), (case.name, table[~keeps])
 
 
-@pytest.mark.parametrize("scale", [1.0, 2.0])
+@pytest.mark.parametrize("scale", [pytest.param(1.0, marks=pytest.mark.slow), 2.0])
 def test_simulator_check_reads_the_robots_stiffness_from_its_recording(tmp_path, scale):
     """A recording simulated with the spring's stiffness x `scale`: the check recovers the scale and says whether
     it lies in the range the corrector is tested for (0.7-1.4)."""

@@ -20,6 +20,8 @@ from seadesign.corrector.stability import MIN_MODULUS_MARGIN, measure_loop_gain
 from seadesign.corrector.train import TrainConfig, fit
 from seadesign.twin import Trial
 
+pytestmark = pytest.mark.slow  # trains two networks and runs 15 closed and broken loops: about a minute
+
 TRIALS = [Trial("front", 0.1, 6.0), Trial("right", 0.2, 6.0), Trial("rotate_right", 0.05, 6.0)]
 
 
