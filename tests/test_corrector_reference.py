@@ -18,7 +18,7 @@ from seadesign.corrector.goal import GOAL_REDUCTION, ROBUST_SHARE, Case, case_ta
 from seadesign.corrector.ilc import ILCSettings
 from seadesign.corrector.imitation import ImitationSettings, label_arrays
 from seadesign.corrector.runtime import FeedForward, HallPI, NoCorrection, ReferenceFeedForward
-from seadesign.corrector.workflow import load_corrector, train_reference_bundle
+from seadesign.corrector.workflow import evaluate_bundles, load_corrector, train_reference_bundle
 from seadesign.design.spring import write_spring
 from seadesign.twin import Gait, Trial, thesis_protocol
 
@@ -49,6 +49,13 @@ def test_reference_bundle_records_its_simulator_and_runs_as_trained(tmp_path):
     mem = ReferenceFeedForward(NumpyCorrector(numpy_arrays(result.training.net)), SMALL.window, spring["k_Nm_per_rad"])
     b = run_closed_loop(mem, spring, trials)
     np.testing.assert_array_equal(a.command, b.command)
+    # evaluate without recordings: closed loop only, with the stability verdict (no feedback: L = 0, margin 1)
+    res = evaluate_bundles([bundle], [], tmp_path / "eval", closed_loop=("hanging",), trial_s=3.0)
+    assert "open_loop" not in res and res["settings"]["not_judged_open_loop"] == ["reference-ilc"]
+    rows = {r["candidate"]: r for r in res["closed_loop"]}
+    assert set(rows) == {"none", "pi", "feedforward", "reference-ilc"}
+    assert rows["reference-ilc"]["stable"] and rows["reference-ilc"]["modulus_margin"] == 1.0
+    assert rows["reference-ilc"]["mean_abs_error_rad"] < 0.2 * rows["pi"]["mean_abs_error_rad"]
 
 
 def meta_check(bundle) -> list:

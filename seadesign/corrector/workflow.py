@@ -201,6 +201,7 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
                  plot_predictions(traces, out / "predictions_right.png", knee=1)]
         result["open_loop"] = table.to_dict("records")
         result["files"] += [str(p) for p in [*files.values(), *plots]]
+    out.mkdir(parents=True, exist_ok=True)
     curves = plot_curves({m["name"]: pd.read_csv(b / "training_curve.csv").to_dict("records")
                           for b, (_, m) in zip(bundles, nets)}, out / "training_curves.png")
     result["files"].append(str(curves))
