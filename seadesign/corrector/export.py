@@ -66,23 +66,18 @@ class _Forward(nn.Module):
         return self.units
 
 
-class _Exported(nn.Module):
+class _Exported(_Forward):
     """TorchScript wrapper: the network on flat raw inputs (`forward`), and the online path
     `step` that keeps each knee's history window and applies the right knee's mirroring, exactly
     as the training dataset laid the inputs out (`FeatureBuilder`)."""
 
-    names: list[str]
-    units: list[str]
     measured: list[str]
     siamese: bool
     n_channels: int
     hall: int
 
     def __init__(self, net: CorrectorNet, names: list[str], units: list[str], spec: DatasetSpec) -> None:
-        super().__init__()
-        self.net = net
-        self.names = names
-        self.units = units
+        super().__init__(net, names, units)
         self.siamese = isinstance(net.core, SiameseCore)
         chans = list(channels(spec.modalities))
         self.n_channels = len(chans)
@@ -93,17 +88,6 @@ class _Exported(nn.Module):
         self.register_buffer("sign_right", torch.tensor(-1.0 if spec.positive else 1.0))
         self.register_buffer("past", torch.zeros(2, spec.history + 1, len(self.measured)))
         self.register_buffer("count", torch.zeros(2, dtype=torch.long))
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        return self.net(x)
-
-    @torch.jit.export
-    def input_names(self) -> list[str]:
-        return self.names
-
-    @torch.jit.export
-    def input_units(self) -> list[str]:
-        return self.units
 
     @torch.jit.export
     def measured_names(self) -> list[str]:
