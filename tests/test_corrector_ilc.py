@@ -65,6 +65,14 @@ def test_ilc_converges_and_its_commands_replay(short_batch):
     assert np.mean(np.abs(res.target_rad - hall)) == pytest.approx(errors[res.best_iteration], rel=1e-12)
 
 
+def test_ilc_keeps_the_correction_inside_its_bound_on_both_sides():
+    """With a bound the knee's dynamics need more than (0.05 rad), the correction reaches it both ways and
+    never passes it."""
+    res = learn_commands(thesis_spring(), [Trial("front", 0.2, 3.0)], settings=ILCSettings(max_correction_rad=0.05))
+    assert res.correction_rad.max() == pytest.approx(0.05, abs=1e-12)
+    assert res.correction_rad.min() == pytest.approx(-0.05, abs=1e-12)
+
+
 def test_ilc_that_stops_before_its_plateau_is_not_a_label(spring_dict):
     settings = ImitationSettings(speeds=(0.1,), settings=("hanging",), k_scales=(1.0,), trial_s=3.0,
                                  ilc=ILCSettings(max_iterations=2))
