@@ -47,6 +47,17 @@ def require_module(name: str, install: str) -> ModuleType:
 
 
 @pytest.fixture
+def one_torch_thread():
+    """One intra-op torch thread for the test (small batches: faster than two, as training sets it)."""
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(before)
+
+
+@pytest.fixture
 def ccx() -> str:
     """CalculiX, the independent solver."""
     return require_tool("ccx", "Debian: apt-get install calculix-ccx")

@@ -25,13 +25,7 @@ WINDOW = ReferenceWindow()
 QUIET = ["hall_noise=off", "hall_quantisation=off", "motor_quantisation=off", "effort_noise=off"]
 
 
-@pytest.fixture(autouse=True)
-def one_thread():
-    """Small batches: one intra-op thread is faster than two (as the training sets it)."""
-    before = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(before)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def _policy(seed: int = 0, spread: float = 1.0) -> tuple[ClosedLoopPolicy, np.ndarray]:

@@ -24,12 +24,7 @@ MAX_ERROR = {"hall": 2e-5, "motor": 5e-6, "effort": 4e-3, "velocity": 1e-3, "hal
 MEAN_ERROR = {"hall": 6e-7, "motor": 1e-7, "effort": 1e-5, "velocity": 4e-6, "hall_velocity": 1.5e-5}
 
 
-@pytest.fixture(autouse=True)
-def _one_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def _softening(spring: dict, a_Nm: float = 6.0) -> dict:

@@ -31,8 +31,8 @@ BASELINES = ("none", "pi", "feedforward")
 
 @dataclass(frozen=True)
 class Case:
-    """A simulator variant: effects switched on with their values, a gait, and the spring's law
-    ("spring.json": as given; "curve": a softening curve in place of k; "k": k in place of the curve)."""
+    """A simulator variant: effects switched on with their values, a gait, and the spring's law ("spring.json":
+    as given; "swap": a softening curve in place of k, or k in place of spring.json's curve)."""
 
     name: str
     effects: dict[str, dict[str, float]] = field(default_factory=dict)

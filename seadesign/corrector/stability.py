@@ -85,12 +85,12 @@ def measure_loop_gain(corrector: Corrector, spring: dict[str, Any], trials: list
     chain = session.pop("effects", None) or knee_effects(KneeConfig.from_spring(spring), ground)
     for name in NOISE_EFFECTS:
         chain = chain.configure(name, enabled=False)
-    sim = KneeSession(spring, trials, ground=ground, rate_hz=rate_hz, seed=seed, effects=chain, **session)
-    c0 = sim.target.copy()  # the operating point: the knee driven by the walk engine's commands
+    sims = [KneeSession(spring, trials, ground=ground, rate_hz=rate_hz, seed=seed, effects=chain, **session)
+            for _ in range(2)]
+    c0 = sims[0].target.copy()  # the operating point: the knee driven by the walk engine's commands
     d = INJECTION_RAD * np.sign(effect_rng(seed, "loop_gain_injection").uniform(-1.0, 1.0, c0.shape))
     answers = []
-    for injected in (np.zeros_like(c0), d):
-        sim = KneeSession(spring, trials, ground=ground, rate_hz=rate_hz, seed=seed, effects=chain, **session)
+    for sim, injected in zip(sims, (np.zeros_like(c0), d)):
         driver, answer = Driver(corrector, sim), np.empty_like(c0)
         obs = sim.observe()
         while obs is not None:
