@@ -69,7 +69,7 @@ def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: 
     spring = load_spring(spring_path)
     if not data and any(m != "reference" for m in models):
         raise click.BadParameter("models trained on recordings need --data FILE (repeat for several files)")
-    recs = load_recordings(list(data)) if data else []
+    recs = load_recordings(list(data)) if any(m != "reference" for m in models) else []  # reference: simcheck reads them
     cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=max_seconds,
                       batch_size=batch_size, lr=lr)
     root = Path(out) if out else Path("exports") / spring["study"] / "corrector"

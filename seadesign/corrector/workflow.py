@@ -185,7 +185,7 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
                     f"k = {k:g} Nm/rad" + ("" if spring is not None else f" ({spring_file} not found)"))
     correctors: list[Corrector] = [NoCorrection(), HallPI(kp, ki), FeedForward(k, curve)] + [c for c, _ in nets]
     measured = [(b, c, m) for b, (c, m) in zip(bundles, nets) if m["model"] != "reference"]
-    context = {"reference_bundle": str(bundles[0]), "data": data_record(data_paths) if data_paths else [],
+    context = {"reference_bundle": str(bundles[0]), "data": data_record(data_paths),
                "k_Nm_per_rad": k, "feed_forward_spring": feed_forward, "pi": {"kp": kp, "ki": ki}, "versions": versions(),
                "candidates": {m["name"]: {"bundle": str(b), "training": m["training"], "split": m["split"]}
                               for b, (_, m) in zip(bundles, nets)},
