@@ -110,7 +110,7 @@ def test_a_thin_plate_in_torsion_stops_where_the_tangent_loses_stability():
     p = path_problem(mesh, law, PathSettings(), 2, None, None, None, "full")
 
     def smallest(u):
-        k = full_from_upper(p.solid.tangent(u, p.node_index, len(p.free)).matrix()).tocsc()
+        k = full_from_upper(p.solid.tangent(u, p.pattern).matrix()).tocsc()
         return sla.eigsh(k, k=1, sigma=0, which="LM", return_eigenvectors=False)[0]
 
     at_rest, at_stop = smallest(np.zeros_like(path.displacement_m)), smallest(path.displacement_m)

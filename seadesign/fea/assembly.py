@@ -2,7 +2,9 @@
 
 Assembly works on node pairs: every element contributes its nen(nen+1)/2 upper pair blocks,
 each mapped to global block rows (transposed where the global order flips, dropped where a
-node has no row, e.g. a held node), and equal (row, col) entries are summed with bincount.
+node has no row, e.g. a held node), and equal (row, col) entries are summed (`fea.kernels`). The
+map from element blocks to global entries depends only on the mesh and the numbering: a
+`PairPattern` keeps it for matrices assembled many times (the finite-strain tangent).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from seadesign.fea.elements import (
     stiffness_blocks,
     upper_pairs,
 )
+from seadesign.fea.kernels import sum_blocks
 
 _CHUNK = 8192  # elements per vectorised block
 
@@ -43,25 +46,44 @@ class UpperBlocks:
         return sp.bsr_matrix((self.values, self.cols, indptr), shape=(d * self.n, d * self.n))
 
 
+@dataclass(frozen=True)
+class PairPattern:
+    """Where the element pair blocks (P, m, d, d) of one mesh and numbering land in the global upper
+    triangle, computed once: the global entry each block adds to (-1: dropped, a node without a row),
+    transposed where the global order of its pair flips."""
+
+    rows: np.ndarray
+    cols: np.ndarray
+    n: int
+    target: np.ndarray  # (P * m,) global entry of each pair block, -1: dropped
+    flip: np.ndarray  # (P * m,) the block is added transposed
+
+    @classmethod
+    def of(cls, elements: np.ndarray, order: int, node_index: np.ndarray, n: int) -> "PairPattern":
+        """node_index maps mesh nodes to block rows (-1: no row, e.g. a held node)."""
+        ia, ib = upper_pairs(order)
+        r = node_index[elements[:, ia].T].ravel()
+        c = node_index[elements[:, ib].T].ravel()
+        kept = (r >= 0) & (c >= 0)
+        keys, inv = np.unique(np.minimum(r[kept], c[kept]).astype(np.int64) * n + np.maximum(r[kept], c[kept]),
+                              return_inverse=True)
+        target = np.full(len(r), -1, dtype=np.int64)
+        target[kept] = inv
+        return cls(keys // n, keys % n, n, target, r > c)
+
+    def sum(self, blocks: np.ndarray) -> UpperBlocks:
+        """The global upper blocks of element pair blocks (P, m, d, d) over upper_pairs(order)."""
+        d = blocks.shape[-1]
+        return UpperBlocks(self.rows, self.cols, sum_blocks(blocks.reshape(-1, d, d), self.target, self.flip,
+                                                            len(self.rows)), self.n)
+
+
 def sum_pair_blocks(
     elements: np.ndarray, order: int, blocks: np.ndarray, node_index: np.ndarray, n: int
 ) -> UpperBlocks:
-    """Sum element pair blocks (P, m, d, d) over upper_pairs(order) (overwrites blocks);
-    node_index maps mesh nodes to block rows (-1: no row)."""
-    ia, ib = upper_pairs(order)
-    d = blocks.shape[-1]
-    r = node_index[elements[:, ia].T].ravel()
-    c = node_index[elements[:, ib].T].ravel()
-    v = blocks.reshape(-1, d, d)
-    keep = (r >= 0) & (c >= 0)
-    if not keep.all():
-        r, c, v = r[keep], c[keep], v[keep]
-    swap = r > c
-    v[swap] = v[swap].transpose(0, 2, 1)
-    keys, inv = np.unique(np.minimum(r, c).astype(np.int64) * n + np.maximum(r, c), return_inverse=True)
-    flat = v.reshape(len(v), d * d)
-    summed = np.stack([np.bincount(inv, weights=flat[:, j], minlength=len(keys)) for j in range(d * d)], axis=1)
-    return UpperBlocks(keys // n, keys % n, summed.reshape(-1, d, d), n)
+    """Sum element pair blocks (P, m, d, d) over upper_pairs(order); node_index maps mesh nodes to block
+    rows (-1: no row). For one numbering used many times, keep its `PairPattern`."""
+    return PairPattern.of(elements, order, node_index, n).sum(blocks)
 
 
 def _stiffness_pair_blocks(mesh: ElementMesh, elements: np.ndarray, lam: float, mu: float) -> np.ndarray:

@@ -9,45 +9,46 @@ leading axes of F (..., 3, 3). Moduli in Pa, compressibilities in 1/Pa (0: the t
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from seadesign.design.materials import Hyperelastic
+from seadesign.fea.kernels import det_inverse_transpose
 
 _I = np.eye(3)
 
 
-@dataclass(frozen=True)
 class _Kinematics:
-    """Invariants of F (..., 3, 3) and their first derivatives with respect to F."""
+    """Invariants of F (..., 3, 3) and their first derivatives with respect to F; those of I2 are
+    computed when a law asks for them (Mooney-Rivlin)."""
 
-    F: np.ndarray
-    J: np.ndarray
-    H: np.ndarray  # F^-T
-    I1: np.ndarray
-    I2: np.ndarray
-    C: np.ndarray
-    dI2: np.ndarray  # dI2/dF = 2 (I1 F - F C)
+    def __init__(self, F: np.ndarray) -> None:
+        self.F = F
+        self.J, self.H = det_and_inverse_transpose(F)  # H = F^-T
+        self.I1 = np.einsum("...ij,...ij->...", F, F)
 
-    @classmethod
-    def of(cls, F: np.ndarray) -> "_Kinematics":
-        J, H = det_and_inverse_transpose(F)
-        C = np.swapaxes(F, -1, -2) @ F
-        I1 = np.trace(C, axis1=-2, axis2=-1)
-        I2 = 0.5 * (I1**2 - np.sum(C * C, axis=(-2, -1)))
-        dI2 = 2.0 * (I1[..., None, None] * F - F @ C)
-        return cls(F, J, H, I1, I2, C, dI2)
+    @cached_property
+    def C(self) -> np.ndarray:
+        return np.swapaxes(self.F, -1, -2) @ self.F
+
+    @cached_property
+    def I2(self) -> np.ndarray:
+        return 0.5 * (self.I1**2 - np.sum(self.C * self.C, axis=(-2, -1)))
+
+    @cached_property
+    def dI2(self) -> np.ndarray:
+        """dI2/dF = 2 (I1 F - F C)."""
+        return 2.0 * (self.I1[..., None, None] * self.F - self.F @ self.C)
 
 
 def det_and_inverse_transpose(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """det F and F^-T of each F (..., 3, 3) from the cofactors (columns c_i: cof = [c1 x c2, c2 x c0, c0 x c1]);
     FloatingPointError when an element is inverted (det F <= 0)."""
-    c0, c1, c2 = F[..., :, 0], F[..., :, 1], F[..., :, 2]
-    cof = np.stack([np.cross(c1, c2), np.cross(c2, c0), np.cross(c0, c1)], axis=-1)
-    J = np.sum(c0 * cof[..., :, 0], axis=-1)
+    J, H = det_inverse_transpose(np.ascontiguousarray(F, dtype=float).reshape(-1, 3, 3))
     if np.any(J <= 0):
         raise FloatingPointError("inverted element: det F <= 0")
-    return J, cof / J[..., None, None]
+    return J.reshape(F.shape[:-2]), H.reshape(F.shape)
 
 
 def volumetric(law: Hyperelastic, J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -62,20 +63,18 @@ def volumetric(law: Hyperelastic, J: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return u, du, ddu
 
 
-def _isochoric(law: Hyperelastic, i1b: np.ndarray, i2b: np.ndarray) -> tuple[np.ndarray, ...]:
-    """dW/dI1bar, dW/dI2bar, d2W/dI1bar2, d2W/dI2bar2 (no mixed terms in these laws)."""
-    a, b = i1b - 3.0, i2b - 3.0
-    w1 = law.c10_Pa + 2 * law.c20_Pa * a + 3 * law.c30_Pa * a**2
-    w11 = 2 * law.c20_Pa + 6 * law.c30_Pa * a
-    return w1, np.full_like(b, law.c01_Pa), w11, np.zeros_like(b)
+def _isochoric(law: Hyperelastic, i1b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """dW/dI1bar and d2W/dI1bar2 (Pa). These laws are linear in I2bar (dW/dI2bar = C01) with no mixed terms."""
+    a = i1b - 3.0
+    return law.c10_Pa + 2 * law.c20_Pa * a + 3 * law.c30_Pa * a**2, 2 * law.c20_Pa + 6 * law.c30_Pa * a
 
 
 def isochoric_energy_density(law: Hyperelastic, F: np.ndarray) -> np.ndarray:
     """The isochoric part of W (J/m^3) at each F (..., 3, 3)."""
-    kin = _Kinematics.of(F)
+    kin = _Kinematics(F)
     a = kin.J ** (-2 / 3) * kin.I1 - 3.0
-    b = kin.J ** (-4 / 3) * kin.I2 - 3.0
-    return law.c10_Pa * a + law.c20_Pa * a**2 + law.c30_Pa * a**3 + law.c01_Pa * b
+    w = law.c10_Pa * a + law.c20_Pa * a**2 + law.c30_Pa * a**3
+    return w + law.c01_Pa * (kin.J ** (-4 / 3) * kin.I2 - 3.0) if law.c01_Pa else w
 
 
 def energy_density(law: Hyperelastic, F: np.ndarray) -> np.ndarray:
@@ -83,24 +82,27 @@ def energy_density(law: Hyperelastic, F: np.ndarray) -> np.ndarray:
     return isochoric_energy_density(law, F) + volumetric(law, np.linalg.det(F))[0]
 
 
-def _first(kin: _Kinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """I1bar, I2bar and their derivatives dI1bar/dF, dI2bar/dF."""
-    j23, j43 = kin.J ** (-2 / 3), kin.J ** (-4 / 3)
-    e = (..., None, None)
-    d1 = j23[e] * (2.0 * kin.F - (2 / 3) * kin.I1[e] * kin.H)
-    d2 = j43[e] * (kin.dI2 - (4 / 3) * kin.I2[e] * kin.H)
-    return j23 * kin.I1, j43 * kin.I2, d1, d2
+def _first(kin: _Kinematics) -> tuple[np.ndarray, np.ndarray]:
+    """I1bar and dI1bar/dF."""
+    j23 = kin.J ** (-2 / 3)
+    return j23 * kin.I1, j23[..., None, None] * (2.0 * kin.F - (2 / 3) * kin.I1[..., None, None] * kin.H)
+
+
+def _second(kin: _Kinematics) -> tuple[np.ndarray, np.ndarray]:
+    """I2bar and dI2bar/dF."""
+    j43 = kin.J ** (-4 / 3)
+    return j43 * kin.I2, j43[..., None, None] * (kin.dI2 - (4 / 3) * kin.I2[..., None, None] * kin.H)
 
 
 def stress(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> np.ndarray:
     """First Piola-Kirchhoff stress P = dW/dF (Pa), shape of F. `pressure_Pa` replaces U'(J) (a mean
     dilatation formulation passes U' of the element's mean J)."""
-    kin = _Kinematics.of(F)
-    i1b, i2b, d1, d2 = _first(kin)
-    w1, w2, *_ = _isochoric(law, i1b, i2b)
+    kin = _Kinematics(F)
+    i1b, d1 = _first(kin)
     wj = _volumetric_slopes(law, kin.J, pressure_Pa)[0]
     e = (..., None, None)
-    return w1[e] * d1 + w2[e] * d2 + (wj * kin.J)[e] * kin.H
+    p = _isochoric(law, i1b)[0][e] * d1 + (wj * kin.J)[e] * kin.H
+    return p + law.c01_Pa * _second(kin)[1] if law.c01_Pa else p
 
 
 def _outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -145,9 +147,9 @@ def i1_tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None 
     """The terms of dP/dF for a law without I2bar (law.c01_Pa == 0); `pressure_Pa` as in `tangent`."""
     if law.c01_Pa:
         raise ValueError("i1_tangent takes laws in I1bar and J only; use tangent for Mooney-Rivlin")
-    kin = _Kinematics.of(F)
-    i1b, i2b, d1, _ = _first(kin)
-    w1, _, w11, _ = _isochoric(law, i1b, i2b)
+    kin = _Kinematics(F)
+    i1b, d1 = _first(kin)
+    w1, w11 = _isochoric(law, i1b)
     wj, wjj = _volumetric_slopes(law, kin.J, pressure_Pa)
     J, I1 = kin.J, kin.I1
     s = w1 * J ** (-2 / 3)
@@ -164,9 +166,9 @@ def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = N
     if not law.c01_Pa:
         t = i1_tangent(law, F, pressure_Pa)
         return t.P, t.full()
-    kin = _Kinematics.of(F)
-    i1b, i2b, d1, d2 = _first(kin)
-    w1, w2, w11, w22 = _isochoric(law, i1b, i2b)
+    kin = _Kinematics(F)
+    (i1b, d1), (_, d2) = _first(kin), _second(kin)
+    (w1, w11), w2 = _isochoric(law, i1b), law.c01_Pa
     wj, wjj = _volumetric_slopes(law, kin.J, pressure_Pa)
     F, H, J, I1, I2 = kin.F, kin.H, kin.J, kin.I1, kin.I2
     e, e4 = (..., None, None), (..., None, None, None, None)
@@ -180,9 +182,9 @@ def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = N
         -(2 / 3) * _outer(2.0 * F - (2 / 3) * I1[e] * H, H)
         + 2.0 * ii - (4 / 3) * _outer(H, F) + (2 / 3) * I1[e4] * hx
     )
-    P = w1[e] * d1 + w2[e] * d2 + (wj * J)[e] * H
+    P = w1[e] * d1 + (wj * J)[e] * H + w2 * d2  # the order of `stress`: the same P to the last bit
     a = w11[e4] * _outer(d1, d1) + w1[e4] * dd1
-    if np.any(w2) or np.any(w22):
+    if w2:
         # d2 I2 / dF2 = 2 (2 F_kL F_iJ + I1 d_ik d_JL - d_ik C_LJ - F_iL F_kJ - b_ik d_JL), b = F F^T
         b = F @ np.swapaxes(F, -1, -2)
         ff = _outer(F, F)
@@ -193,7 +195,7 @@ def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = N
             -(4 / 3) * _outer(kin.dI2 - (4 / 3) * I2[e] * H, H)
             + ddi2 - (4 / 3) * _outer(H, kin.dI2) + (4 / 3) * I2[e4] * hx
         )
-        a = a + w22[e4] * _outer(d2, d2) + w2[e4] * dd2
+        a = a + w2 * dd2
     # d/dF (dW/dJ J H) = (d2W/dJ2 J^2 + dW/dJ J) H x H - dW/dJ J H_iL H_kJ
     a = a + (wjj * J**2 + wj * J)[e4] * hh - (wj * J)[e4] * hx
     return P, a

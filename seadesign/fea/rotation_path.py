@@ -33,6 +33,7 @@ from scipy.spatial import cKDTree
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import NotPositiveDefinite, SolverError
+from seadesign.fea.assembly import PairPattern
 from seadesign.fea.elements import ElementMesh, element_mesh
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.pardiso import Pardiso
@@ -48,8 +49,9 @@ class PathSettings:
     max_step_rad: float = 0.1
     min_step_rad: float = 1e-4
     max_rotation_rad: float = 6.0
-    max_iterations: int = 12
+    max_iterations: int = 30
     force_rtol: float = 1e-7  # residual norm over the norm of the reaction forces
+    refresh_ratio: float = 0.5  # Newton refactors the tangent when an iteration cuts the residual by less than this
     locate_tol_rad: float = 1e-3  # bisection tolerance of a limit point's, bifurcation's or strain limit's rotation
     contact_locate_tol_rad: float = 1e-2  # bisection tolerance of contact (then interpolated in the gap)
     contact_gap_mm: float = 0.1  # a quarter of an extrusion width: printed faces are not truer than that
@@ -85,6 +87,7 @@ class TorquePath:
     displacement_m: np.ndarray = field(repr=False)  # (N, 3) at the last converged point
     emesh: ElementMesh = field(repr=False)
     cut_backs: int = 0
+    factorizations: int = 0  # tangent factorizations, cut-back attempts included
     time_s: float = 0.0
     snapshot_index: int = -1  # the point whose displacement is `snapshot_displacement_m` (see rotation_path)
     snapshot_displacement_m: np.ndarray | None = field(default=None, repr=False)
@@ -118,8 +121,9 @@ class _Problem:
     rest_normals: np.ndarray  # outward unit normals of the boundary vertices at rest
     settings: PathSettings
     dof_free: np.ndarray  # (n_free, 3) 1.0 for a free degree of freedom of a free node, 0.0 for one held at zero
-    pardiso: Pardiso | None = None
-    factored_this_step: bool = False  # the factorization is of a Newton iterate of the current increment
+    pattern: PairPattern  # where the tangent's element blocks land (free nodes only)
+    pardiso: Pardiso | None = None  # the factorization last made
+    factorizations: int = 0
 
     def residual(self, f: np.ndarray) -> np.ndarray:
         """The out-of-balance forces (N) on the free degrees of freedom, flattened."""
@@ -148,14 +152,14 @@ class _Problem:
         """LDL^T factorization of the free-node tangent at u; NotPositiveDefinite when its inertia counts a
         negative eigenvalue (the state has lost stability). The inertia is exact, where a Cholesky
         factorization near a singular point may or may not meet its negative pivot."""
-        k = self.solid.tangent(u, self.node_index, len(self.free))
+        k = self.solid.tangent(u, self.pattern)
         self._hold(k)
         k = k.matrix()
         if self.pardiso is not None and self.pardiso.alive:
             self.pardiso.refactor(k)
         else:
             self.pardiso = Pardiso(k, indefinite=True)
-        self.factored_this_step = True
+        self.factorizations += 1
         if self.pardiso.inertia()[1] > 0:
             raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
         return self.pardiso
@@ -233,7 +237,14 @@ def _min_gap_mm(p: _Problem, u: np.ndarray) -> tuple[float, tuple[float, float, 
 def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, np.ndarray | None, list[float], str]:
     """Equilibrium of the free nodes at hub rotation theta from the guess u0: (u, its internal forces,
     residual norms, status) with status "converged", "unstable" (a tangent that is not positive
-    definite) or "failed"."""
+    definite) or "failed".
+
+    Newton's method with the tangent refactored only when needed: between refactorizations the tangent
+    last factored (the previous converged state's, or after a cut-back the rejected attempt's) is
+    corrected by BFGS updates from the iterations since (Matthies and Strang's quasi-Newton method for
+    finite elements). It is refactored at the current iterate when an iteration cuts the residual by
+    less than `refresh_ratio`, or its direction finds no descent. A backtracking line search on the
+    energy guards every step."""
     u = u0.copy()
     u[p.hub] = p.hub_displacement(theta)
     norms: list[float] = []
@@ -241,45 +252,77 @@ def _newton(p: _Problem, u0: np.ndarray, theta: float) -> tuple[np.ndarray, np.n
         f = p.solid.forces(u)
     except FloatingPointError:
         return u, None, norms, "failed"
-    p.factored_this_step = False
+    r = p.residual(f)
+    fresh = False  # the held factorization is of the current iterate
+    refresh = p.pardiso is None or not p.pardiso.alive
+    updates: list[tuple[np.ndarray, np.ndarray, float]] = []  # BFGS pairs (s, y, 1 / y.s) since the factorization
     for _ in range(p.settings.max_iterations):
-        r = p.residual(f)
         norms.append(float(np.linalg.norm(r)))
         if p.converged(f, norms[-1]):
             return u, f, norms, "converged"
-        try:
-            du = -p.factor(u).solve(r).reshape(-1, 3)
-        except NotPositiveDefinite:
-            return u, f, norms, "unstable"
-        e0, slope = None, float(r @ du.ravel())
-        alpha = 1.0
-        while alpha > 1e-3:
-            trial = u.copy()
-            trial[p.free] += alpha * du
+        if refresh and not fresh:
             try:
-                f1 = p.solid.forces(trial)
-                # accept when the residual falls, else when the energy falls as Armijo asks
-                if np.linalg.norm(p.residual(f1)) < norms[-1]:
-                    break
-                e0 = p.solid.energy(u) if e0 is None else e0
-                if p.solid.energy(trial) <= e0 + 1e-4 * alpha * slope:
-                    break
-            except FloatingPointError:  # an element inverted: shorten the step
-                pass
-            alpha *= 0.5
-        else:
-            return u, f, norms, "failed"
-        u, f = trial, f1
-    norms.append(float(np.linalg.norm(p.residual(f))))
+                p.factor(u)
+            except NotPositiveDefinite:
+                return u, f, norms, "unstable"
+            fresh, updates = True, []
+        trial, f1 = _line_search(p, u, f, r, -_bfgs_solve(p.pardiso, r, updates).reshape(-1, 3), norms[-1])
+        if trial is None:
+            if fresh:
+                return u, f, norms, "failed"
+            refresh = True
+            norms.pop()
+            continue
+        r1 = p.residual(f1)
+        step, change = (trial[p.free] - u[p.free]).ravel(), r1 - r
+        curvature = float(step @ change)
+        if curvature > 0:
+            updates.append((step, change, 1.0 / curvature))
+        refresh = float(np.linalg.norm(r1)) > p.settings.refresh_ratio * norms[-1]
+        u, f, r, fresh = trial, f1, r1, False
+    norms.append(float(np.linalg.norm(r)))
     return u, f, norms, "converged" if p.converged(f, norms[-1]) else "failed"
+
+
+def _bfgs_solve(factorization: Pardiso, r: np.ndarray, updates: list[tuple[np.ndarray, np.ndarray, float]]) -> np.ndarray:
+    """H r with H the inverse of the factored tangent corrected by the BFGS pairs (the two-loop recursion)."""
+    q, alphas = r.copy(), []
+    for s, y, rho in reversed(updates):
+        alphas.append(rho * float(s @ q))
+        q -= alphas[-1] * y
+    z = factorization.solve(q)
+    for (s, y, rho), alpha in zip(updates, reversed(alphas)):
+        z += (alpha - rho * float(y @ z)) * s
+    return z
+
+
+def _line_search(p: _Problem, u: np.ndarray, f: np.ndarray, r: np.ndarray, du: np.ndarray,
+                 norm: float) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """u + alpha du for the first alpha in 1, 1/2, ... 1/1000 whose residual norm is below `norm`, else whose
+    energy falls as Armijo asks; (None, None) when none does."""
+    e0, slope = None, float(r @ du.ravel())
+    alpha = 1.0
+    while alpha > 1e-3:
+        trial = u.copy()
+        trial[p.free] += alpha * du
+        try:
+            f1 = p.solid.forces(trial)
+            if np.linalg.norm(p.residual(f1)) < norm:
+                return trial, f1
+            e0 = p.solid.energy(u) if e0 is None else e0
+            if p.solid.energy(trial) <= e0 + 1e-4 * alpha * slope:
+                return trial, f1
+        except FloatingPointError:  # an element inverted: shorten the step
+            pass
+        alpha *= 0.5
+    return None, None
 
 
 def _state(p: _Problem, u: np.ndarray, f: np.ndarray, theta: float, iterations: int,
            norms: list[float]) -> tuple[PathPoint, np.ndarray]:
-    """The converged point at u (internal forces f) and the path's direction du/dtheta there
-    (NotPositiveDefinite: unstable). The tangent is the last Newton iteration's (within the residual
-    tolerance of u), else factored at u."""
-    fac = p.pardiso if p.factored_this_step else p.factor(u)
+    """The converged point at u (internal forces f) and the path's direction du/dtheta there, from the
+    tangent factored at u (NotPositiveDefinite: unstable); the next increment's Newton starts with it."""
+    fac = p.factor(u)
     v = np.zeros_like(u)
     v[p.hub] = p.hub_velocity(theta)
     v[p.free] = -fac.solve(p.residual(p.solid.tangent_product(u, v))).reshape(-1, 3)
@@ -321,7 +364,7 @@ def path_problem(mesh: TetMesh, law: Hyperelastic, settings: PathSettings, order
         dof_free[held[held >= 0], 2] = 0.0
     rest_normals = _vertex_normals(emesh.nodes_m, mesh.boundary_faces, surface)
     return _Problem(Solid.of(emesh, law, formulation), hub, free, index, surface, mesh.boundary_faces, rest_normals,
-                    settings, dof_free)
+                    settings, dof_free, PairPattern.of(emesh.elements, order, index, len(free)))
 
 
 def _stop_check(p: _Problem, prev: PathPoint, point: PathPoint, target_Nm: float) -> str | None:
@@ -366,7 +409,7 @@ def rotation_path(
     try:
         first, v = _state(p, u, np.zeros_like(u), 0.0, 0, [0.0])
         points, step, cuts, reason, previous = [first], settings.first_step_rad, 0, None, None
-        snapshot = None
+        snapshot, probe = None, None  # probe: the last attempt rejected for contact since the last point
         while reason is None:
             last = points[-1]
             step = min(step, settings.max_step_rad, settings.max_rotation_rad - last.rotation_rad)
@@ -385,23 +428,46 @@ def rotation_path(
             elif status != "converged" or (event not in (None, "target_reached", "rotation_limit") and not located):
                 # not converged, or an event (limit point, contact, strain limit) to be located more closely
                 cuts += 1
-                step *= 0.5
+                contact = None
+                if event == "contact":  # the secant through the last two attempts, else through the bracket
+                    estimates = (_contact_rotation(a, point, settings) for a in (probe, last) if a is not None)
+                    contact = next((c for c in estimates if c is not None and last.rotation_rad < c < theta), None)
+                    probe = point
+                step = step * 0.5 if contact is None else _bracketing_step(contact, last.rotation_rad, settings)
                 if status == "failed" and step < settings.min_step_rad:
                     reason = "unconverged"
             else:
                 points.append(point)
                 if snapshot is None and snapshot_torque_Nm is not None and point.torque_Nm >= snapshot_torque_Nm:
                     snapshot = (len(points) - 1, trial)
-                previous = (u, last.rotation_rad)
+                previous, probe = (u, last.rotation_rad), None
                 u, v, reason = trial, v_new, event
-                if len(norms) <= 5:
+                if len(norms) <= 8:
                     step *= 1.5
+                contact = _contact_rotation(last, point, settings)  # a closing gap: bracket where it closes
+                if contact is not None and contact > point.rotation_rad:
+                    step = min(step, _bracketing_step(contact, point.rotation_rad, settings))
     finally:
         p.close()
     stop_theta, stop_torque = _stop_point(points, reason, target_torque_Nm, settings.contact_gap_mm)
     index, shot = snapshot or (len(points) - 1, u)
-    return TorquePath(tuple(points), reason, stop_theta, stop_torque, u, p.solid.mesh, cuts, time.perf_counter() - t0,
-                      index, shot)
+    return TorquePath(tuple(points), reason, stop_theta, stop_torque, u, p.solid.mesh, cuts, p.factorizations,
+                      time.perf_counter() - t0, index, shot)
+
+
+def _contact_rotation(a: PathPoint, b: PathPoint, s: PathSettings) -> float | None:
+    """Where the gap, linear through a and b, reaches `contact_gap_mm` (rad); None unless both gaps are
+    finite and differ."""
+    if not (np.isfinite(a.min_gap_mm) and np.isfinite(b.min_gap_mm)) or a.min_gap_mm == b.min_gap_mm:
+        return None
+    return a.rotation_rad + (a.min_gap_mm - s.contact_gap_mm) / (a.min_gap_mm - b.min_gap_mm) * (b.rotation_rad - a.rotation_rad)
+
+
+def _bracketing_step(contact_rad: float, theta: float, s: PathSettings) -> float:
+    """The step from theta toward a predicted contact: 0.3 of the locating tolerance short of it when it lies
+    further than the tolerance, else as far past it (within the tolerance, so that the bracket locates it)."""
+    tol, ahead = s.contact_locate_tol_rad, contact_rad - theta
+    return ahead - 0.3 * tol if ahead > tol else min(tol, ahead + 0.3 * tol)
 
 
 def _predict(p: _Problem, u: np.ndarray, v: np.ndarray, step: float,

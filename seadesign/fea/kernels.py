@@ -1,0 +1,182 @@
+"""Compiled element loops of the finite-strain tangent: the pair blocks
+K_ab[i, k] = sum_q w_q G_aJ A_iJkL G_bL (N/m) of each element, from the law's tangent at its
+quadrature points and the shape-function gradients G_a = sum_j D[q, a, j] Gamma_j (1/m).
+
+The loops run once per element and quadrature point and keep G_a, F G_a, H G_a in registers;
+NumPy needs several passes over (m, q, 4, 3, 4, 3) arrays for the same sum (`benchmarks/fea.py`
+times both). Compiled by numba (a dependency of cadquery), cached on disk after the first call.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def _gradients(dlam: np.ndarray, gamma: np.ndarray, q: int, e: int, out: np.ndarray) -> None:
+    """G_a = sum_j D[q, a, j] Gamma[e, j] into out (nen, 3)."""
+    for a in range(dlam.shape[1]):
+        for i in range(3):
+            s = 0.0
+            for j in range(4):
+                s += dlam[q, a, j] * gamma[e, j, i]
+            out[a, i] = s
+
+
+@njit(cache=True, nogil=True)
+def _apply(x: np.ndarray, g: np.ndarray, out: np.ndarray) -> None:
+    """(X G_a)_i = X_iJ G_aJ into out (nen, 3) for X (3, 3)."""
+    for a in range(g.shape[0]):
+        for i in range(3):
+            out[a, i] = x[i, 0] * g[a, 0] + x[i, 1] * g[a, 1] + x[i, 2] * g[a, 2]
+
+
+@njit(cache=True, nogil=True)
+def i1_pair_blocks(dlam: np.ndarray, gamma: np.ndarray, weights: np.ndarray, F: np.ndarray, H: np.ndarray,
+                   D: np.ndarray, delta: np.ndarray, cross: np.ndarray, hh: np.ndarray, hx: np.ndarray,
+                   w11: np.ndarray, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
+    """Pair blocks (P, m, 3, 3) of a law in I1bar and J (`hyperelastic.I1Tangent`): with A = delta d_ik d_JL
+    + cross (F_iJ H_kL + H_iJ F_kL) + hh H_iJ H_kL + hx H_iL H_kJ + w11 D_iJ D_kL,
+    K_ab[i, k] = sum_q w (delta (G_a . G_b) d_ik + cross ((F G_a)_i (H G_b)_k + (H G_a)_i (F G_b)_k)
+    + hh (H G_a)_i (H G_b)_k + hx (H G_b)_i (H G_a)_k + w11 (D G_a)_i (D G_b)_k).
+    dlam (q, nen, 4), gamma (m, 4, 3), weights (m, q) in m^3, F, H, D (m, q, 3, 3), the terms (m, q) in Pa."""
+    m, nq, nen, npairs = gamma.shape[0], dlam.shape[0], dlam.shape[1], len(ia)
+    out = np.zeros((npairs, m, 3, 3))
+    g, fg, hg, dg = np.empty((nen, 3)), np.empty((nen, 3)), np.empty((nen, 3)), np.empty((nen, 3))
+    for e in range(m):
+        for q in range(nq):
+            w = weights[e, q]
+            _gradients(dlam, gamma, q, e, g)
+            _apply(F[e, q], g, fg)
+            _apply(H[e, q], g, hg)
+            use_d = w11[e, q] != 0.0
+            if use_d:
+                _apply(D[e, q], g, dg)
+            cd, cc, ch, cx, c11 = w * delta[e, q], w * cross[e, q], w * hh[e, q], w * hx[e, q], w * w11[e, q]
+            for p in range(npairs):
+                a, b = ia[p], ib[p]
+                gg = cd * (g[a, 0] * g[b, 0] + g[a, 1] * g[b, 1] + g[a, 2] * g[b, 2])
+                for i in range(3):
+                    for k in range(3):
+                        v = (cc * (fg[a, i] * hg[b, k] + hg[a, i] * fg[b, k]) + ch * hg[a, i] * hg[b, k]
+                             + cx * hg[b, i] * hg[a, k])
+                        if use_d:
+                            v += c11 * dg[a, i] * dg[b, k]
+                        if i == k:
+                            v += gg
+                        out[p, e, i, k] += v
+    return out
+
+
+@njit(cache=True, nogil=True)
+def general_pair_blocks(dlam: np.ndarray, gamma: np.ndarray, weights: np.ndarray, A: np.ndarray, ia: np.ndarray,
+                        ib: np.ndarray) -> np.ndarray:
+    """Pair blocks (P, m, 3, 3) from the full tangent A (m, q, 3, 3, 3, 3) in Pa, A[iJkL] = dP_iJ / dF_kL:
+    K_ab[i, k] = sum_q w sum_JL G_aJ A_iJkL G_bL (any law, e.g. Mooney-Rivlin)."""
+    m, nq, nen, npairs = gamma.shape[0], dlam.shape[0], dlam.shape[1], len(ia)
+    out = np.zeros((npairs, m, 3, 3))
+    g = np.empty((nen, 3))
+    t = np.empty((nen, 3, 3, 3))  # T_a[i, k, L] = w sum_J G_aJ A_iJkL
+    for e in range(m):
+        for q in range(nq):
+            w = weights[e, q]
+            _gradients(dlam, gamma, q, e, g)
+            for a in range(nen):
+                for i in range(3):
+                    for k in range(3):
+                        for L in range(3):
+                            t[a, i, k, L] = w * (g[a, 0] * A[e, q, i, 0, k, L] + g[a, 1] * A[e, q, i, 1, k, L]
+                                                 + g[a, 2] * A[e, q, i, 2, k, L])
+            for p in range(npairs):
+                a, b = ia[p], ib[p]
+                for i in range(3):
+                    for k in range(3):
+                        out[p, e, i, k] += t[a, i, k, 0] * g[b, 0] + t[a, i, k, 1] * g[b, 1] + t[a, i, k, 2] * g[b, 2]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def deformation_gradients(dlam: np.ndarray, gamma: np.ndarray, elements: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """F = I + sum_a u_a G_a^T (m, q, 3, 3) at the quadrature points; elements (m, nen), u (N, 3) in m."""
+    m, nq, nen = gamma.shape[0], dlam.shape[0], dlam.shape[1]
+    out = np.zeros((m, nq, 3, 3))
+    g = np.empty((nen, 3))
+    for e in range(m):
+        for q in range(nq):
+            _gradients(dlam, gamma, q, e, g)
+            for a in range(nen):
+                node = elements[e, a]
+                for i in range(3):
+                    ui = u[node, i]
+                    for j in range(3):
+                        out[e, q, i, j] += ui * g[a, j]
+            for i in range(3):
+                out[e, q, i, i] += 1.0
+    return out
+
+
+@njit(cache=True, nogil=True)
+def contract(dlam: np.ndarray, gamma: np.ndarray, weights: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Element vectors f_ai = sum_q w P_iJ G_aJ (m, nen, 3) of a stress-like field P (m, q, 3, 3) in Pa."""
+    m, nq, nen = gamma.shape[0], dlam.shape[0], dlam.shape[1]
+    out = np.zeros((m, nen, 3))
+    g = np.empty((nen, 3))
+    for e in range(m):
+        for q in range(nq):
+            w = weights[e, q]
+            _gradients(dlam, gamma, q, e, g)
+            for a in range(nen):
+                for i in range(3):
+                    out[e, a, i] += w * (P[e, q, i, 0] * g[a, 0] + P[e, q, i, 1] * g[a, 1] + P[e, q, i, 2] * g[a, 2])
+    return out
+
+
+@njit(cache=True, nogil=True)
+def add_element_vectors(f: np.ndarray, elements: np.ndarray, fe: np.ndarray) -> None:
+    """f[elements[e, a]] += fe[e, a] (in place) for nodal vectors f (N, 3) and element vectors fe (m, nen, 3)."""
+    for e in range(elements.shape[0]):
+        for a in range(elements.shape[1]):
+            node = elements[e, a]
+            for i in range(3):
+                f[node, i] += fe[e, a, i]
+
+
+@njit(cache=True, nogil=True)
+def det_inverse_transpose(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """det F (n,) and F^-T (n, 3, 3) of F (n, 3, 3) from the cofactors; det F <= 0 is left to the caller."""
+    n = F.shape[0]
+    J, H = np.empty(n), np.empty((n, 3, 3))
+    for e in range(n):
+        f = F[e]
+        for j in range(3):  # column j of the cofactor matrix is c_(j+1) x c_(j+2), c_j the columns of F
+            a, b = (j + 1) % 3, (j + 2) % 3
+            for i in range(3):
+                k, m = (i + 1) % 3, (i + 2) % 3
+                H[e, i, j] = f[k, a] * f[m, b] - f[m, a] * f[k, b]
+        J[e] = f[0, 0] * H[e, 0, 0] + f[1, 0] * H[e, 1, 0] + f[2, 0] * H[e, 2, 0]
+        for i in range(3):
+            for j in range(3):
+                H[e, i, j] /= J[e]
+    return J, H
+
+
+@njit(cache=True, nogil=True)
+def sum_blocks(blocks: np.ndarray, target: np.ndarray, flip: np.ndarray, n: int) -> np.ndarray:
+    """Global blocks (n, d, d): the sum of blocks (k, d, d) over their targets (-1: dropped), each transposed
+    where `flip`."""
+    d = blocks.shape[1]
+    out = np.zeros((n, d, d))
+    for b in range(blocks.shape[0]):
+        t = target[b]
+        if t < 0:
+            continue
+        if flip[b]:
+            for i in range(d):
+                for j in range(d):
+                    out[t, i, j] += blocks[b, j, i]
+        else:
+            for i in range(d):
+                for j in range(d):
+                    out[t, i, j] += blocks[b, i, j]
+    return out
