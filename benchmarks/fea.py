@@ -7,8 +7,9 @@ Prints machine, settings, per-stage seconds and the ratio (our assembly + factor
 / (ccx wall time, which includes its own input reading, assembly and solve). Then the
 large-deflection path (fea.rotation_path, to the stall torque or where it stops, no strain stop):
 its time split into assembly / factorization / solve / stop checks (the solver's methods timed from
-here, the library unchanged), Newton iterations per increment, and CalculiX NLGEOM on the same mesh
-and rotations with the time ratio and the torque agreement. --coarsening C makes every mesh size C
+here, the library unchanged), Newton iterations per increment, one assembly of the residual and the
+tangent at the path's last state against scikit-fem's assembly of the same law (tests/helpers_skfem.py),
+and CalculiX NLGEOM on the same mesh and rotations with the time ratio and the torque agreement. --coarsening C makes every mesh size C
 times coarser, as the sweep's error-estimate mesh (C = 4: a few minutes in all).
 """
 
@@ -18,6 +19,7 @@ import argparse
 import os
 import platform
 import shutil
+import sys
 import tempfile
 import time
 from collections import defaultdict
@@ -35,6 +37,11 @@ from seadesign.fea.loadcases import analyse
 from seadesign.fea.pardiso import Pardiso
 from seadesign.mesh import mesh_part
 from seadesign.design.study import load_study
+from seadesign.fea.elements import element_mesh
+from seadesign.fea.linsolve import full_from_upper
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from helpers_skfem import neo_hooke_forms, skfem_permutation  # noqa: E402  the tests' independent law
 
 # the path's time split: the methods timed in each part (a method called inside another is not nested here)
 PATH_PARTS = {
@@ -172,6 +179,7 @@ def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool) -> None:
     other = path.time_s - sum(s for s, _ in parts.values())
     print(f"{'other (set-up, predictor, bookkeeping)':<44}{other:>9.2f}{1e3 * other / factorizations:>20.1f}")
     print(f"{'path total':<44}{path.time_s:>9.2f}{1e3 * path.time_s / factorizations:>20.1f}")
+    assembly_vs_skfem(mesh, law, path.displacement_m)
     if not use_ccx:
         return
     theta = [p.rotation_rad for p in points]
@@ -187,6 +195,31 @@ def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool) -> None:
     print(f"torque: max |T_ccx / T_ours - 1| = {diff.max():.1e} over {n} rotations to {theta[n - 1]:.4f} rad "
           f"(at the last: {diff[-1]:.1e})")
     print(f"ours (path total) / CalculiX = {path.time_s:.2f} / {cc.wall_s:.2f} = {path.time_s / cc.wall_s:.2f}")
+
+
+def assembly_vs_skfem(mesh, law, u: np.ndarray) -> None:
+    """Residual and tangent at u (the whole mesh, no constraints): ours against scikit-fem's assembly of the
+    same neo-Hookean law, timed after one warm-up call each, with their largest difference."""
+    from skfem import asm
+
+    solid = Solid.of(element_mesh(mesh.points_mm * 1e-3, mesh.tets, 2), law)
+    basis, perm = skfem_permutation(mesh.points_mm * 1e-3, mesh.tets, solid.mesh, intorder=2)
+    residual, stiffness = neo_hooke_forms(law.c10_Pa, law.d1_per_Pa)
+    prev = basis.interpolate(u.ravel()[perm])
+    times = {}
+    for name, fn in [("ours", lambda: (solid.forces(u), solid.tangent(u))),
+                     ("scikit-fem", lambda: (asm(residual, basis, prev=prev), asm(stiffness, basis, prev=prev)))]:
+        fn()
+        t = time.perf_counter()
+        out = fn()
+        times[name] = time.perf_counter() - t
+        if name == "ours":
+            f, k = out[0].ravel()[perm], full_from_upper(out[1].matrix())[perm][:, perm]
+        else:
+            df, dk = np.abs(out[0] - f).max() / np.abs(out[0]).max(), abs(out[1] - k).max() / abs(out[1]).max()
+    print(f"residual + tangent assembly at the last state: ours {times['ours']:.2f} s, scikit-fem "
+          f"{times['scikit-fem']:.2f} s (ratio {times['ours'] / times['scikit-fem']:.3f}); largest difference "
+          f"{df:.1e} (residual), {dk:.1e} (tangent), relative to the largest entry")
 
 
 if __name__ == "__main__":

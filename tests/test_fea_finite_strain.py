@@ -1,15 +1,14 @@
 """Finite-strain elasticity against independent references: finite differences of the energy,
-scikit-fem's assembly of the same law written here on its own (directional derivative in
-closed form), the linear model at zero strain, and the linear solver's torsional stiffness."""
+scikit-fem's assembly of the same law written on its own in helpers_skfem (directional derivative
+in closed form), the linear model at zero strain, and the linear solver's torsional stiffness."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from helpers_annulus import annulus_mesh
-from helpers_skfem import skfem_permutation
-from skfem import BilinearForm, LinearForm, asm
-from skfem.helpers import grad
+from helpers_skfem import neo_hooke_forms, skfem_permutation
+from skfem import asm
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.fea.assembly import stiffness_upper
@@ -59,45 +58,6 @@ def test_neo_hooke_from_E_and_nu_is_the_linear_model_at_zero_strain():
 # --- scikit-fem: the same compressible neo-Hookean law (CalculiX's NEO HOOKE), written independently ----
 
 
-def _last(a):  # (3, 3, e, q) -> (e, q, 3, 3)
-    return np.moveaxis(a, (0, 1), (-2, -1))
-
-
-def _first(a):
-    return np.moveaxis(a, (-2, -1), (0, 1))
-
-
-def _neo_hooke_parts(F, c10, d1):
-    Fl = _last(F)
-    J = np.linalg.det(Fl)
-    H = np.swapaxes(np.linalg.inv(Fl), -1, -2)
-    I1 = np.einsum("...ij,...ij->...", Fl, Fl)
-    return Fl, J, H, I1
-
-
-def _P(F, c10, d1):
-    Fl, J, H, I1 = _neo_hooke_parts(F, c10, d1)
-    j23 = J ** (-2 / 3)
-    P = c10 * j23[..., None, None] * (2 * Fl - (2 / 3) * I1[..., None, None] * H) \
-        + (2 / d1) * ((J - 1) * J)[..., None, None] * H
-    return _first(P)
-
-
-def _dP(F, G, c10, d1):
-    """Directional derivative of P at F along G (both (3, 3, e, q))."""
-    Fl, J, H, I1 = _neo_hooke_parts(F, c10, d1)
-    Gl = _last(G)
-    hg = np.einsum("...ij,...ij->...", H, Gl)  # tr(F^-1 G)
-    dI1 = 2 * np.einsum("...ij,...ij->...", Fl, Gl)
-    dH = -H @ np.swapaxes(Gl, -1, -2) @ H
-    j23 = J ** (-2 / 3)
-    e = (..., None, None)
-    iso = c10 * (-(2 / 3) * (j23 * hg)[e] * (2 * Fl - (2 / 3) * I1[e] * H)
-                 + j23[e] * (2 * Gl - (2 / 3) * dI1[e] * H - (2 / 3) * I1[e] * dH))
-    vol = (2 / d1) * (((2 * J - 1) * J * hg)[e] * H + ((J - 1) * J)[e] * dH)
-    return _first(iso + vol)
-
-
 @pytest.fixture(scope="module")
 def small():
     m = annulus_mesh(5.0, 12.0, 3.0, n_r=2, n_theta=12, n_z=1)
@@ -115,18 +75,8 @@ def test_residual_and_tangent_equal_scikit_fem(small):
     k = full_from_upper(solid.tangent(u).matrix()).toarray()
 
     basis, perm = skfem_permutation(points, tets, emesh, intorder=2)  # the 4-point rule, as ours
-    c10, d1 = NEO.c10_Pa, NEO.d1_per_Pa
+    residual, stiffness = neo_hooke_forms(NEO.c10_Pa, NEO.d1_per_Pa)
     prev = basis.interpolate(u.ravel()[perm])
-
-    @LinearForm
-    def residual(v, w):
-        return np.einsum("ij...,ij...->...", _P(grad(w["prev"]) + np.eye(3)[:, :, None, None], c10, d1), grad(v))
-
-    @BilinearForm
-    def stiffness(du, v, w):
-        F = grad(w["prev"]) + np.eye(3)[:, :, None, None]
-        return np.einsum("ij...,ij...->...", _dP(F, grad(du), c10, d1), grad(v))
-
     f_ref = asm(residual, basis, prev=prev)
     k_ref = asm(stiffness, basis, prev=prev).toarray()
     assert np.abs(solid.deformation_gradient(u) - np.eye(3)).max() > 0.05  # finite strain (0.09), not the linear limit

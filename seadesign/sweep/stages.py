@@ -8,9 +8,9 @@ changing one input recomputes only the stages that depend on it. The FEA is solv
 columns are made from these objects in `sweep/table.py`.
 
 Meshing is `seadesign.mesh.mesh_part`, the solve `seadesign.fea.loadcases.analyse` at 1 Nm per
-load case; a second P2 solve on a mesh COARSENING times coarser gives the discretization-error
-estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest order observed in
-benchmarks/fea_convergence.py).
+load case; a second P2 solve on the large-deflection path's mesh (`SolverSettings.path_coarsening`
+times coarser, meshed once for both) gives the discretization-error estimate of k (two-level
+Richardson at CONVERGENCE_ORDER, the smallest order observed in benchmarks/fea_convergence.py).
 """
 
 from __future__ import annotations
@@ -32,7 +32,6 @@ if TYPE_CHECKING:
     from seadesign.fea.results import LinearResults
 
 Progress = Callable[[str], None]  # receives the name of the stage that starts
-COARSENING = 1.5  # edge-length ratio of the error-estimate mesh to the result mesh
 CONVERGENCE_ORDER = 1.1  # smallest order of k observed in benchmarks/fea_convergence.py (1.10-1.89)
 
 
@@ -52,7 +51,8 @@ class UnitResponse:
     estimate's coarse k, and how the mesh and solve went."""
 
     results: LinearResults  # both load cases at 1 Nm
-    k_coarse_Nm_per_rad: float  # k on a COARSENING times coarser mesh (error estimate of k)
+    k_coarse_Nm_per_rad: float  # k on the coarse mesh (error estimate of k)
+    coarsening: float  # edge-length ratio of the coarse mesh to the result mesh
     time_fea_total_s: float
     time_error_estimate_s: float
     mesh_mean_aspect_ratio: float
@@ -77,7 +77,7 @@ def fea_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str
     this module with everything it imports (the solver, the mesher, the study's mesh sizing)."""
     m = candidate.material
     return digest("fea", mesh_key(study, candidate), m.youngs_modulus_Pa, m.poisson_ratio,
-                  settings.element_order, settings.linear_solver,
+                  settings.element_order, settings.linear_solver, settings.path_coarsening,
                   code_fingerprint("seadesign.sweep.stages", "seadesign.mesh.worker"), package_versions())
 
 
@@ -118,6 +118,7 @@ def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, setting
     return UnitResponse(
         results=a.results,
         k_coarse_Nm_per_rad=1.0 / float(coarse.hub_motion[5]),
+        coarsening=settings.path_coarsening,
         time_fea_total_s=t1 - t0,
         time_error_estimate_s=time.perf_counter() - t1,
         mesh_mean_aspect_ratio=mesh.quality.mean_aspect_ratio,
@@ -150,7 +151,7 @@ def fea_response(study: Study, candidate: Candidate, part: Callable[[], Part], s
         return unit
     progress("mesh")
     mesh = tetrahedralize(study, candidate, part(), cache)
-    coarse_mesh = tetrahedralize(study, candidate, part(), cache, COARSENING)
+    coarse_mesh = tetrahedralize(study, candidate, part(), cache, settings.path_coarsening)
     progress("fea")
     unit = unit_response(mesh, coarse_mesh, study, candidate, settings)
     cache.put("fea", fkey, unit)
