@@ -68,3 +68,19 @@ def test_a_step_calculix_does_not_converge_is_named_and_left_out(tmp_path, ccx):
     np.testing.assert_array_equal(cc.rotation_rad, [0.1])
     ours = rotation_path(mesh, LAW, 100.0, PathSettings(max_rotation_rad=0.1)).points[-1]
     assert ours.rotation_rad == 0.1 and cc.torque_Nm == pytest.approx([ours.torque_Nm], rel=RTOL)
+
+
+@pytest.mark.default_mesh
+def test_calculix_nlgeom_agrees_on_the_default_mesh(tmp_path, ccx):
+    """8 beams x 4 mm (the part of DOMAIN.md's CalculiX runs) on the study's default mesh (about 450k
+    degrees of freedom) to 0.1 rad: hours of CalculiX on 2 cores, so not run in CI (`-m default_mesh`)."""
+    from seadesign.design.study import load_study
+    from seadesign.run.cache import Cache
+    from seadesign.sweep.stages import tetrahedralize
+
+    study = load_study()
+    checked, part = study.check(study.candidate(beam_count=8, beam_thickness_mm=4.0))
+    mesh = tetrahedralize(study, checked, part, Cache(tmp_path / "cache"))
+    path = rotation_path(mesh, study.material.law, study.load_cases.stall_torque_Nm, PathSettings(max_rotation_rad=0.1))
+    assert path.stop_reason == "rotation_limit"
+    assert _ccx_difference(tmp_path, mesh, study.material.law, path).max() < RTOL

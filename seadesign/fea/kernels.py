@@ -1,10 +1,12 @@
-"""Compiled element loops of the finite-strain tangent: the pair blocks
-K_ab[i, k] = sum_q w_q G_aJ A_iJkL G_bL (N/m) of each element, from the law's tangent at its
-quadrature points and the shape-function gradients G_a = sum_j D[q, a, j] Gamma_j (1/m).
+"""Compiled element loops of the finite-strain solid and the block assembly: deformation gradients,
+internal-force contractions, the tangent's pair blocks K_ab[i, k] = sum_q w_q G_aJ A_iJkL G_bL (N/m)
+from the law's tangent at the quadrature points, det F with F^-T, and the sum of element blocks into
+the global ones. Shape-function gradients are G_a = sum_j D[q, a, j] Gamma_j (1/m): the constant
+derivatives D of the reference element and each element's barycentric gradients Gamma.
 
-The loops run once per element and quadrature point and keep G_a, F G_a, H G_a in registers;
-NumPy needs several passes over (m, q, 4, 3, 4, 3) arrays for the same sum (`benchmarks/fea.py`
-times both). Compiled by numba (a dependency of cadquery), cached on disk after the first call.
+Each loop makes one pass per element and quadrature point, where NumPy needs several passes over
+(m, q, nen, 3) temporaries (the README gives the measured times). Compiled by numba (cadquery installs it),
+cached on disk after the first call.
 """
 
 from __future__ import annotations
