@@ -10,7 +10,7 @@ import torch
 from conftest import thesis_spring
 
 from seadesign.corrector.closedloop import closed_loop_table, run_closed_loop
-from seadesign.corrector.closedloop_training import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, ClosedLoopCorrector,
+from seadesign.corrector.closedloop_training import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, runtime_corrector,
                                                      ClosedLoopPolicy, ClosedLoopSettings, FeedbackBranch,
                                                      train_closed_loop, window_policy)
 from seadesign.corrector.goal import goal_table
@@ -84,11 +84,11 @@ def test_feedback_bound_is_reached_by_aligned_weights_and_not_passed():
 
 def test_runtime_is_the_policy_and_mirrors_the_right_knee():
     policy, X = _policy(seed=2, spread=0.5)
-    runtime = ClosedLoopCorrector(policy, 9.106)
+    runtime = runtime_corrector(policy, 9.106)
     m = np.random.default_rng(4).normal(scale=0.1, size=(20, 2))
     with torch.no_grad():
         expected = policy(torch.as_tensor(X[:20], dtype=torch.float32), torch.as_tensor(m, dtype=torch.float32))
-    got = [runtime.policy_command(X[i], m[i]) for i in range(20)]
+    got = [runtime.model.command(X[i], m[i]) for i in range(20)]
     np.testing.assert_allclose(got, expected.numpy(), rtol=1e-5, atol=1e-5)
     preview = Preview(np.linspace(1.0, 1.1, 10), np.full(11, 0.5))
     mirrored = Preview(-preview.target_rad, preview.load_share)
@@ -189,7 +189,7 @@ def test_runtime_in_the_simulator_follows_the_policy_in_the_torch_knee(spring_di
     trials = [Trial("front", 0.15, 3.0), Trial("back_right", 0.1, 3.0)]
     cfg = KneeConfig.from_spring(spring_dict)
     chain = configure_chain(knee_effects(cfg, ground=True), QUIET)
-    run = run_closed_loop(ClosedLoopCorrector(policy, spring_dict["k_Nm_per_rad"]), spring_dict, trials, ground=True,
+    run = run_closed_loop(runtime_corrector(policy, spring_dict["k_Nm_per_rad"]), spring_dict, trials, ground=True,
                           effects=chain)
     assert not run.unstable
     target, stance, x = _walk(spring_dict, trials)
@@ -239,7 +239,7 @@ def test_family2_from_scratch_meets_the_closed_loop_goal_in_every_cell():
     spring = thesis_spring()
     k = spring["k_Nm_per_rad"]
     res = train_closed_loop(spring, SLOW)
-    corrector = ClosedLoopCorrector(res.policy, k, name="family2")
+    corrector = runtime_corrector(res.policy, k, name="family2")
     runs, rows = {}, {}
     for setting in ("hanging", "ground"):
         table, runs[setting] = closed_loop_table([NoCorrection(), HallPI(), FeedForward(k), corrector], spring,
