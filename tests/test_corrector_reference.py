@@ -96,16 +96,20 @@ def test_default_train_meets_the_closed_loop_goal_on_unseen_trajectories_and_rob
         assert keeps.all(), (case.name, table[~keeps])
 
 
-@pytest.mark.parametrize("scale", [pytest.param(1.0, marks=pytest.mark.slow), 2.0])
-def test_simulator_check_reads_the_robots_stiffness_from_its_recording(tmp_path, scale):
-    """A recording simulated with the spring's stiffness x `scale`: the check recovers the scale and says whether
-    it lies in the range the corrector is tested for (0.7-1.4)."""
+@pytest.mark.parametrize("scale,offset_rad", [pytest.param(1.0, 0.0, marks=pytest.mark.slow), (2.0, 0.0),
+                                              pytest.param(1.0, 0.05, marks=pytest.mark.slow)])
+def test_simulator_check_reads_the_robots_stiffness_and_hall_offset_from_its_recording(tmp_path, scale, offset_rad):
+    """A recording simulated with the spring's stiffness x `scale` and a Hall offset: the check recovers the scale,
+    says whether it lies in the range the corrector is tested for (0.7-1.4), and finds a Hall offset exactly when
+    there is one (the hanging shank's sag at rest, 0.048 rad, is no offset: the cleaning used to make it one)."""
     from seadesign.corrector.simcheck import check_simulator
     from seadesign.data import write_recording
     from seadesign.twin import KneeConfig, KneeSession, knee_effects
 
     spring = thesis_spring()
     chain = knee_effects(KneeConfig.from_spring(spring)).configure("stiffness_scale", enabled=True, scale=scale)
+    if offset_rad:
+        chain = chain.configure("hall_offset", enabled=True, offset_rad=offset_rad)
     session = KneeSession(spring, [Trial("front", 0.1, 15.0), Trial("right", 0.2, 15.0)], effects=chain)
     path = write_recording(session.run(), tmp_path / "walk.csv", metadata=session.metadata())
     checks = check_simulator(spring, [path])
@@ -113,3 +117,4 @@ def test_simulator_check_reads_the_robots_stiffness_from_its_recording(tmp_path,
     for c in checks:
         assert c.stiffness_scale == pytest.approx(scale, rel=0.06)  # measured 1.8-3 % low
         assert c.within_robust_range == (scale == 1.0)
+        assert c.found == (("sensor_offset",) if offset_rad else ())
