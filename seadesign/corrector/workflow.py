@@ -161,6 +161,7 @@ def export_closedloop_bundle(result: ClosedLoopResult, spring_path: str | Path, 
         "normalisation": {**normalisation(policy.ff), "applies_to": "the reference window; the measured inputs "
                           "enter the feedback in rad, unscaled"},
         "simulator": _simulator_record(spring, settings.settings, settings.k_scales),
+        "split": {"split": "held_out_speeds", "val_speeds_m_per_s": list(settings.val_speeds)},
         **(record or {}), "training": result.summary(),
     }
     out = export_bundle(FlatPolicy(policy), meta, out_dir, arrays=policy_arrays(policy))
