@@ -241,6 +241,11 @@ class ClosedLoopSettings:
         return asdict(self)
 
 
+#: settings for fine-tuning a family-1 network (the default corrector): Adam's step a tenth of the from-scratch
+#: one, as the feed-forward starts trained
+FINE_TUNING = ClosedLoopSettings(lr=1e-3)
+
+
 @dataclass
 class ClosedLoopResult:
     """The trained policy and its record. curve rows: epoch, validation mean |Hall error| (rad), validation rest

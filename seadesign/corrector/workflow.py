@@ -18,15 +18,14 @@ import pandas as pd
 from seadesign.corrector.closedloop import closed_loop_table
 from seadesign.corrector.dataset import CorrectorDataset, DatasetSpec, Recording, build_dataset
 from seadesign.corrector.evaluate import open_loop_table
-from seadesign.corrector.closedloop_training import (MEASURED_INPUTS, RATE_TIME_S, ClosedLoopResult, ClosedLoopSettings,
-                                                     FlatPolicy, policy_arrays, train_closed_loop)
+from seadesign.corrector.closedloop_training import (FINE_TUNING, MEASURED_INPUTS, RATE_TIME_S, ClosedLoopResult,
+                                                     ClosedLoopSettings, FlatPolicy, policy_arrays, train_closed_loop)
 from seadesign.corrector.export import export_bundle, input_list, load_meta, load_numpy, normalisation, versions
 from seadesign.corrector.modalities import COMBINATIONS
 from seadesign.corrector.recordings import load_recordings
 from seadesign.corrector.report import plot_curves, plot_predictions, write_table
 from seadesign.corrector.imitation import ImitationResult, ImitationSettings, train_imitation
 from seadesign.corrector.reference import ReferenceWindow
-from seadesign.corrector.models import CorrectorNet
 from seadesign.corrector.runtime import (ClosedLoopCorrector, Corrector, FeedForward, HallPI, NetCorrector, NoCorrection,
                                          ReferenceFeedForward)
 from seadesign.corrector.simcheck import SimulatorCheck, check_simulator
@@ -104,12 +103,14 @@ def _simulator_record(spring: dict[str, Any], settings: tuple[str, ...], k_scale
 
 def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
                            settings: ImitationSettings = ImitationSettings(), data_paths: list[str | Path] = (),
+                           checks: list[SimulatorCheck] | None = None,
                            ) -> tuple[Path, ImitationResult, list[SimulatorCheck]]:
     """Family 1: ILC labels in the simulator built from spring.json, the reference-window network trained on
     them, exported as a bundle whose meta records the window, k, the simulator and the control rate. The
-    recordings in `data_paths`, if any, check that simulator (`simcheck.check_simulator`; in meta)."""
+    recordings in `data_paths`, if any, check that simulator (`simcheck.check_simulator`, unless its `checks`
+    are given; in meta)."""
     spring = load_spring(spring_path)
-    checks = check_simulator(spring, list(data_paths))
+    checks = check_simulator(spring, list(data_paths)) if checks is None else checks
     result = train_imitation(spring, settings)
     meta = {
         "name": "reference-ilc", "model": "reference", "reference": settings.window.to_dict(),
@@ -128,19 +129,21 @@ def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
     return out, result, checks
 
 
-def train_closedloop_bundle(spring_path: str | Path, out_dir: str | Path,
-                            settings: ClosedLoopSettings = ClosedLoopSettings(), init: CorrectorNet | None = None,
-                            data_paths: list[str | Path] = ()) -> tuple[Path, ClosedLoopResult, list[SimulatorCheck]]:
-    """Family 2: the policy trained through the closed loop in the torch knee built from spring.json (from scratch,
-    or fine-tuning the family-1 network `init`), exported by `export_closedloop_bundle`. The recordings in
-    `data_paths`, if any, check that simulator (`simcheck.check_simulator`; in meta)."""
+def train_closedloop_bundle(spring_path: str | Path, out_dir: str | Path, settings: ClosedLoopSettings = FINE_TUNING,
+                            family1: ImitationResult | None = None, data_paths: list[str | Path] = (),
+                            checks: list[SimulatorCheck] | None = None,
+                            ) -> tuple[Path, ClosedLoopResult, list[SimulatorCheck]]:
+    """Family 2, the default corrector: the family-1 network `family1` (trained here with `ImitationSettings()`
+    when None) fine-tuned through the closed loop in the torch knee built from spring.json, exported by
+    `export_closedloop_bundle`; meta records family 1's training under "init". The recordings in `data_paths`,
+    if any, check that simulator (`simcheck.check_simulator`, unless its `checks` are given; in meta)."""
     spring = load_spring(spring_path)
-    checks = check_simulator(spring, list(data_paths))
-    result = train_closed_loop(spring, settings, init)
+    checks = check_simulator(spring, list(data_paths)) if checks is None else checks
+    family1 = train_imitation(spring) if family1 is None else family1
+    result = train_closed_loop(spring, settings, family1.training.net)
     meta = {"data": data_record(list(data_paths)), "simulator_check": [c.to_dict() for c in checks],
-            "init": "scratch" if init is None else "family-1 network, fine-tuned"}
-    name = "closedloop" if init is None else "closedloop-finetuned"
-    return export_closedloop_bundle(result, spring_path, out_dir, meta, name), result, checks
+            "init": {"family1": family1.summary()}}
+    return export_closedloop_bundle(result, spring_path, out_dir, meta), result, checks
 
 
 def export_closedloop_bundle(result: ClosedLoopResult, spring_path: str | Path, out_dir: str | Path,
