@@ -61,9 +61,9 @@ def meta_check(bundle) -> list:
     return json.loads((bundle / "meta.json").read_text())["simulator_check"]
 
 
-#: thresholds of the comparison below, a few times the margin of the measured run (benchmarks/closed_loop_goal.py):
-#: family 2 keeps >= 0.72 of its nominal gain, family 1 0.70; mean |Hall error| over cases and settings 0.0535 and
-#: 0.0656 rad
+#: thresholds of the comparison below, with room for a run cut by its time cap on a slow machine; measured (this
+#: test and benchmarks/closed_loop_goal.py): family 2 keeps >= 0.722 of its nominal gain, family 1 0.699; mean
+#: |Hall error| over cases and settings 0.0535 and 0.0656 rad
 KEPT_SHARE_MIN = 0.6
 FAMILY2_MEAN_RAD = 0.06
 

@@ -16,14 +16,13 @@ from seadesign.corrector.report import write_table
 from seadesign.corrector.simcheck import check_simulator
 from seadesign.corrector.splits import SPLITS
 from seadesign.corrector.train import TrainConfig
-from seadesign.corrector.workflow import (DEFAULT_HISTORY, candidate_name, evaluate_bundles, train_bundle,
-                                          train_closedloop_bundle, train_reference_bundle)
+from seadesign.corrector.workflow import (DEFAULT_HISTORY, PREVIEW_MODELS, candidate_name, evaluate_bundles,
+                                          train_bundle, train_closedloop_bundle, train_reference_bundle)
 from seadesign.design.spring import load_spring
 from seadesign.twin import thesis_protocol
 
 
-PREVIEW_KINDS = ("closedloop", "reference")  # trained in the knee simulator; --data only checks it
-TRAIN_KINDS = (*PREVIEW_KINDS, *MODEL_KINDS)
+TRAIN_KINDS = (*PREVIEW_MODELS, *MODEL_KINDS)
 
 
 def _models(text: str) -> list[str]:
@@ -81,18 +80,18 @@ def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: 
     trained in the knee simulator built from spring.json; models on recordings with --model."""
     models = _models(model_text)
     spring = load_spring(spring_path)
-    on_data = [m for m in models if m not in PREVIEW_KINDS]
+    on_data = [m for m in models if m not in PREVIEW_MODELS]
     if not data and on_data:
         raise click.BadParameter("models trained on recordings need --data FILE (repeat for several files)")
-    recs = load_recordings(list(data)) if on_data else []  # the preview kinds' simulator check reads the files
+    recs = load_recordings(list(data)) if on_data else []  # the preview models' simulator check reads the files
     cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=max_seconds,
                       batch_size=batch_size, lr=lr)
     root = Path(out) if out else Path("exports") / spring["study"] / "corrector"
-    checks = check_simulator(spring, list(data)) if set(models) & set(PREVIEW_KINDS) else []
+    checks = check_simulator(spring, list(data)) if set(models) & set(PREVIEW_MODELS) else []
     _echo_checks(checks)
     family1 = None
     for model in sorted(models, key=lambda m: m != "reference"):  # family 1 first: family 2 fine-tunes it
-        if model in PREVIEW_KINDS:
+        if model in PREVIEW_MODELS:
             folder = {"reference": "reference-ilc", "closedloop": "closedloop"}[model]
             target = root if (out and len(models) == 1) else root / folder
             if model == "reference":

@@ -28,11 +28,11 @@ not the protocol's speeds) and the validation trials (every direction at `VAL_SP
 on the ground, each with the spring's stiffness scaled by every one of `k_scales` (`imitation.TRAIN_K_SCALES`,
 0.8 / 1 / 1.25), in one batched torch knee (the ground chain; a hanging trial carries no stance load), noise
 on, so the feedback meets the sensor noise it must not amplify. The policy's k input stays spring.json's in
-every row: like the robot, it is not told the true stiffness, and learns a command that serves the range. Each epoch: one pass without gradients
-over whole trials records the state at each window start and scores the validation trials (mean |Hall
-error|, rad); then BPTT through the truncated windows of `window_steps` samples (all, or
-`windows_per_epoch` of them, in a seeded random order), each from its recorded start, one Adam step
-per window on
+every row: like the robot, it is not told the true stiffness, and learns a command that serves the range.
+Each epoch: one pass without gradients over whole trials records the state at each window start and
+scores the validation trials (mean |Hall error|, rad); then BPTT through the truncated windows of
+`window_steps` samples (all, or `windows_per_epoch` of them, in a seeded random order), each from its
+recorded start, one Adam step per window on
 
     loss = mean (target - hall)^2 [rad^2] + `rate_weight_s2` * mean (d(command - target)/dt)^2 [(rad/s)^2]
 
@@ -61,9 +61,9 @@ from torch import nn
 from torch.nn.utils import parametrize
 
 from seadesign.corrector.closedloop import CHATTER_RMS_RAD, chatter_rms
+from seadesign.corrector.export import NumpyClosedLoop
 from seadesign.corrector.imitation import TRAIN_K_SCALES, TRAIN_SPEEDS
 from seadesign.corrector.models import CorrectorNet, MLPCore
-from seadesign.corrector.export import NumpyClosedLoop
 from seadesign.corrector.reference import ReferenceWindow, reference_features
 from seadesign.corrector.runtime import ClosedLoopCorrector
 from seadesign.errors import SeadesignError

@@ -37,8 +37,9 @@ from seadesign.design.spring import load_spring, torque_curve
 from seadesign.twin import KneeConfig, knee_effects, thesis_protocol
 
 DEFAULT_HISTORY = 3  # samples, for the history model when no --history is given
-#: bundles driven from the walk engine's preview (reference window): not scored open loop on recordings
-PREVIEW_MODELS = ("reference", "closedloop")
+#: models driven from the walk engine's preview (reference window), trained in the knee simulator (recordings only
+#: check it) and not scored open loop on recordings; the first is the default of `seadesign train`
+PREVIEW_MODELS = ("closedloop", "reference")
 
 
 def candidate_name(model: str, spec: DatasetSpec) -> str:
