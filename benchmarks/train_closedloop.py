@@ -7,8 +7,8 @@ wall time to its stop rule (family 2, `closedloop_training`: the validation tria
 its best for `patience` epochs; family 1: `benchmarks/train_reference.py`), the epochs, the simulated steps per
 second (one step = one 10 ms sample of the whole batch: training and validation trials x hanging/ground x k scales
 x 2 knees; the no-gradient passes and the BPTT windows together, and the BPTT windows alone), and the NumPy
-runtime's latency per control step (median), then the default's wall time (family 1 + fine-tuning). Compare the
-bundles with
+runtime's latency per control step (median), the default bundle's single-call latency on each path (ONNX Runtime,
+NumPy, TorchScript; 1 thread), then the default's wall time (family 1 + fine-tuning). Compare the bundles with
 
     python benchmarks/closed_loop_goal.py OUT/reference-ilc OUT/closedloop-scratch OUT/closedloop --spring SPRING
 
@@ -30,29 +30,52 @@ import torch
 from seadesign import __version__
 from seadesign.corrector.closedloop_training import (FINE_TUNING, ClosedLoopResult, ClosedLoopSettings, runtime_corrector,
                                                      train_closed_loop)
+from seadesign.corrector.export import load_meta, load_numpy, load_torchscript
 from seadesign.corrector.reference import Preview
+from seadesign.corrector.runtime import STEP_BUDGET_US
 from seadesign.corrector.workflow import export_closedloop_bundle, train_closedloop_bundle, train_reference_bundle
 from seadesign.design.spring import load_spring
+from seadesign.onnx_corrector import load_onnx
 
 THESIS_SPRING = Path(__file__).resolve().parents[1] / "studies" / "thesis_measured_spring.json"
 
 
-def _latency_us(corrector, calls: int) -> float:
-    """Median wall time of one `command` call (us), walking target, left knee."""
-    preview = Preview(np.linspace(1.0, 1.1, corrector.preview_steps), np.full(corrector.preview_steps + 1, 0.5))
-    measured = {"hall_pos_rad": 0.98, "hall_vel_rad_per_s": 0.2}
-    corrector.reset()
+def _median_us(fn, calls: int) -> float:
+    """Median wall time of one call of `fn` (us), after 200 warm-up calls."""
+    for _ in range(200):
+        fn()
     times = np.empty(calls)
     for i in range(calls):
         t0 = time.perf_counter()
-        corrector.command("left", 1.0 + 1e-4 * i, measured, 0.01, preview)
+        fn()
         times[i] = time.perf_counter() - t0
     return float(np.median(times) * 1e6)
 
 
+def _step_us(corrector, calls: int) -> float:
+    """Median wall time of one online `command` call (us): walking target, left knee."""
+    preview = Preview(np.linspace(1.0, 1.1, corrector.preview_steps), np.full(corrector.preview_steps + 1, 0.5))
+    measured = {"hall_pos_rad": 0.98, "hall_vel_rad_per_s": 0.2}
+    corrector.reset()
+    return _median_us(lambda: corrector.command("left", 1.0, measured, 0.01, preview), calls)
+
+
+def _paths_us(bundle: Path, calls: int) -> dict[str, float]:
+    """Median single-call latency (us) of the bundle's flat forward on each path (1 torch thread)."""
+    z = np.zeros(len(load_meta(bundle)["inputs"]), dtype=np.float32)
+    npc, onnx, ts = load_numpy(bundle), load_onnx(bundle), load_torchscript(bundle)
+    before = torch.get_num_threads()
+    torch.set_num_threads(1)
+    with torch.inference_mode():
+        zt = torch.from_numpy(z[None, :])
+        ts_us = _median_us(lambda: ts(zt), calls)
+    torch.set_num_threads(before)
+    return {"onnx": _median_us(lambda: onnx(z), calls), "numpy": _median_us(lambda: npc(z), calls), "torchscript": ts_us}
+
+
 def _row(name: str, res: ClosedLoopResult, k: float, calls: int) -> str:
     bptt_s = sum(row["bptt_s"] for row in res.curve)
-    step_us = _latency_us(runtime_corrector(res.policy, k), calls)
+    step_us = _step_us(runtime_corrector(res.policy, k), calls)
     return (f"{name:<22} {res.settings.lr:>6g} {len(res.curve) - 1:>6} {res.best_epoch:>5} {res.stopped:>10} "
             f"{res.wall_s:>7.1f} {res.simulated_steps / res.wall_s:>8.0f} {res.trained_steps / bptt_s:>12.0f} "
             f"{res.curve[res.best_epoch]['val_mean_abs_error_rad']:>11.4f} {res.policy.feedback_lipschitz_bound():>7.3f} "
@@ -93,6 +116,10 @@ def main() -> None:
     export_closedloop_bundle(scratch, args.spring, args.out / "closedloop-scratch", {"init": "scratch"},
                              name="closedloop-scratch")
     print(_row("scratch", scratch, k, args.calls))
+    paths = _paths_us(args.out / "closedloop", args.calls)
+    print("default bundle, one call of the flat forward (median): " + ", ".join(f"{p} {us:.1f} us" for p, us in
+                                                                              paths.items())
+          + f" (budget {STEP_BUDGET_US:.0f} us: {'within' if max(paths.values()) <= STEP_BUDGET_US else 'OVER'})")
     print(f"default `seadesign train` (family 1, then fine-tuned): {family1_s + tuned.wall_s:.0f} s to a converged "
           f"family-2 corrector; from scratch {scratch.wall_s:.0f} s. Bundles in {args.out}. Other processes share "
           "this CPU.")

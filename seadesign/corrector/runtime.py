@@ -32,6 +32,9 @@ from seadesign.data import KNEE_SIGN_BY_NAME
 from seadesign.design.spring import TorqueCurve
 from seadesign.errors import SeadesignError
 
+#: single-call latency budget of a corrector (us): it has to fit a 1 kHz robot loop (measured in benchmarks/)
+STEP_BUDGET_US = 50.0
+
 
 class Corrector(Protocol):
     """What the open- and closed-loop evaluations drive."""
