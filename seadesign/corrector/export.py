@@ -12,7 +12,8 @@ directory holds:
   when the ``onnx`` extra is installed; every meta.json field is embedded as a JSON-encoded
   metadata property. Run it with `seadesign.onnx_corrector.load_onnx` (onnxruntime, no torch).
   Without the exporter the other files are still written and meta.json's ``onnx.skipped`` says why.
-- ``corrector.npz``: weights and normalisation for `NumpyCorrector`.
+- ``corrector.npz``: weights and normalisation for `NumpyCorrector` (or, for a policy trained through
+  the closed loop, `NumpyClosedLoop`); `load_numpy` picks the one that fits.
 - ``meta.json``: dataset spec, model kind, k, inputs and units, normalisation, split, training
   settings and curve, whatever else the caller records (e.g. simulator and control rate),
   ONNX status, versions.
