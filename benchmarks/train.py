@@ -24,6 +24,7 @@ import torch
 from seadesign.corrector.dataset import DatasetSpec, build_dataset
 from seadesign.corrector.export import export_bundle, input_list, load_numpy, load_torchscript
 from seadesign.corrector.recordings import load_recordings
+from seadesign.corrector.runtime import STEP_BUDGET_US
 from seadesign.corrector.splits import time_block_split
 from seadesign.corrector.synthetic import linear_spring_recording
 from seadesign.corrector.train import TrainConfig, fit
@@ -31,7 +32,6 @@ from seadesign.onnx_corrector import load_onnx
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "deepsea"
 K = 9.106  # Nm/rad, the thesis's measured spring
-BUDGET_US = 50.0  # per single call: the corrector has to fit a 1 kHz robot loop
 
 
 def _latency_us(fn, x, calls: int) -> float:
@@ -87,7 +87,7 @@ def main() -> None:
             np_us = _latency_us(npc, x.astype(np.float32), args.calls)
             onnx_us = _latency_us(load_onnx(bundle), x.astype(np.float32), args.calls)
         lat = {"ts": ts_us, "step": step_us, "np": np_us, "onnx": onnx_us}
-        over += [f"{model} {path} {us:.1f} us" for path, us in lat.items() if us > BUDGET_US]
+        over += [f"{model} {path} {us:.1f} us" for path, us in lat.items() if us > STEP_BUDGET_US]
         s = res.summary()
         print(f"{model:<10} {len(ds):>8} {cfg.batch_size:>6} {s['epochs_run']:>7} {s['best_epoch']:>5} "
               f"{s['stopped']:>10} {s['wall_s']:>7.1f} {s['samples_per_s']:>14.0f} {s['best_val_mse_rad2']:>13.3g} "
@@ -95,7 +95,7 @@ def main() -> None:
     print("latency: median of single-sample calls, 1 torch thread (step: the online TorchScript path with "
           "history and mirroring; onnx: ONNX Runtime, 1 intra-op thread, sequential); samples_per_s counts training samples "
           "seen per second of wall time (incl. validation each epoch). Other processes share this CPU.")
-    print(f"budget {BUDGET_US:.0f} us per call (1 kHz loop): " + ("over: " + ", ".join(over) if over else "every path within"))
+    print(f"budget {STEP_BUDGET_US:.0f} us per call (1 kHz loop): " + ("over: " + ", ".join(over) if over else "every path within"))
 
 
 if __name__ == "__main__":

@@ -1,142 +1,128 @@
-"""Family-2 training benchmark: a corrector trained through the closed loop in the torch knee.
+"""Family-2 training benchmark: the corrector trained through the closed loop in the torch knee, from scratch and
+fine-tuning family 1 (the default of `seadesign train`), with the bundles for the comparison.
 
-Trains from scratch and, with a family-1 network, fine-tuned; prints per run the wall time to the stop rule
-(`closedloop_training`: validation mean |Hall error| not 1 % below its best for `patience` epochs), the epochs,
-the simulated steps per second (one step = one 10 ms sample of the whole batch: training and validation trials x
-hanging/ground x 2 knees; the no-gradient passes and the BPTT windows together, and the BPTT windows alone),
-and the runtime's latency per control step (median). With --evaluate, the closed-loop goal table (per cell)
-against none / PI / k-feed-forward and family 1 in the knee simulator: the thesis protocol (nominal), a held-out
-gait (cycle 0.7 s) and the spring's k scaled by 0.7 and 1.4.
+Trains family 1 (`train_reference_bundle`: ILC labels, then the network), family 2 fine-tuning it (the default,
+`train_closedloop_bundle`) and family 2 from scratch, and writes the three bundles into --out. Prints per run the
+wall time to its stop rule (family 2, `closedloop_training`: the validation trials' mean |Hall error| not 1 % below
+its best for `patience` epochs; family 1: `benchmarks/train_reference.py`), the epochs, the simulated steps per
+second (one step = one 10 ms sample of the whole batch: training and validation trials x hanging/ground x k scales
+x 2 knees; the no-gradient passes and the BPTT windows together, and the BPTT windows alone), and the NumPy
+runtime's latency per control step (median), the default bundle's single-call latency on each path (ONNX Runtime,
+NumPy, TorchScript; 1 thread), then the default's wall time (family 1 + fine-tuning). Compare the bundles with
 
-    python benchmarks/train_closedloop.py [--family1 /tmp/family1.pt] [--evaluate] [--threads 1]
+    python benchmarks/closed_loop_goal.py OUT/reference-ilc OUT/closedloop-scratch OUT/closedloop --spring SPRING
 
---family1: a family-1 `CorrectorNet` saved with torch.save; trained with `train_imitation` (about 6 min) and saved
-there when the file does not exist. Without it only the from-scratch run is made.
+    python benchmarks/train_closedloop.py [--spring studies/thesis_measured_spring.json] [--out DIR] [--threads 1]
 """
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import platform
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 import torch
 
 from seadesign import __version__
-from seadesign.design.spring import load_spring
-from seadesign.corrector.closedloop import closed_loop_table
-from seadesign.corrector.closedloop_training import ClosedLoopCorrector, ClosedLoopSettings, train_closed_loop
-from seadesign.corrector.export import NumpyCorrector, numpy_arrays
-from seadesign.corrector.goal import goal_table
-from seadesign.corrector.imitation import ImitationSettings, train_imitation
+from seadesign.corrector.closedloop_training import (FINE_TUNING, ClosedLoopResult, ClosedLoopSettings, runtime_corrector,
+                                                     train_closed_loop)
+from seadesign.corrector.export import load_meta, load_numpy, load_torchscript
 from seadesign.corrector.reference import Preview
-from seadesign.corrector.runtime import FeedForward, HallPI, NoCorrection, ReferenceFeedForward
-from seadesign.twin import Gait, KneeConfig, knee_effects
+from seadesign.corrector.runtime import STEP_BUDGET_US
+from seadesign.corrector.workflow import export_closedloop_bundle, train_closedloop_bundle, train_reference_bundle
+from seadesign.design.spring import load_spring
+from seadesign.onnx_corrector import load_onnx
 
-SPRING = load_spring(Path(__file__).resolve().parents[1] / "studies" / "thesis_measured_spring.json")
-CASES = {"nominal": {}, "gait 0.7 s": {"gait": Gait(cycle_s=0.7)}, "k x0.7": {"k_scale": 0.7},
-         "k x1.4": {"k_scale": 1.4}}
+THESIS_SPRING = Path(__file__).resolve().parents[1] / "studies" / "thesis_measured_spring.json"
 
 
-def _latency_us(corrector, calls: int) -> float:
-    """Median wall time of one `command` call (us), walking target, left knee."""
-    preview = Preview(np.linspace(1.0, 1.1, corrector.preview_steps), np.full(corrector.preview_steps + 1, 0.5))
-    measured = {"hall_pos_rad": 0.98, "hall_vel_rad_per_s": 0.2}
-    corrector.reset()
+def _median_us(fn, calls: int) -> float:
+    """Median wall time of one call of `fn` (us), after 200 warm-up calls."""
+    for _ in range(200):
+        fn()
     times = np.empty(calls)
     for i in range(calls):
         t0 = time.perf_counter()
-        corrector.command("left", 1.0 + 1e-4 * i, measured, 0.01, preview)
+        fn()
         times[i] = time.perf_counter() - t0
     return float(np.median(times) * 1e6)
 
 
-def _family1(path: Path | None) -> torch.nn.Module | None:
-    if path is None:
-        return None
-    if not path.exists():
-        t0 = time.perf_counter()
-        net = train_imitation(SPRING, ImitationSettings()).training.net
-        torch.save(net, path)
-        print(f"family 1 trained in {time.perf_counter() - t0:.0f} s, saved to {path}", flush=True)
-    return torch.load(path, weights_only=False)
+def _step_us(corrector, calls: int) -> float:
+    """Median wall time of one online `command` call (us): walking target, left knee."""
+    preview = Preview(np.linspace(1.0, 1.1, corrector.preview_steps), np.full(corrector.preview_steps + 1, 0.5))
+    measured = {"hall_pos_rad": 0.98, "hall_vel_rad_per_s": 0.2}
+    corrector.reset()
+    return _median_us(lambda: corrector.command("left", 1.0, measured, 0.01, preview), calls)
 
 
-def _evaluate(correctors: list, names: list[str]) -> pd.DataFrame:
-    """Goal table summary per case and setting for each candidate in `names`."""
-    k = SPRING["k_Nm_per_rad"]
-    cfg = KneeConfig.from_spring(SPRING)
-    rows = []
-    for case, options in CASES.items():
-        for setting in ("hanging", "ground"):
-            session = {key: v for key, v in options.items() if key != "k_scale"}
-            if "k_scale" in options:
-                session["effects"] = knee_effects(cfg, ground=setting == "ground").configure(
-                    "stiffness_scale", enabled=True, scale=options["k_scale"])
-            table, runs = closed_loop_table([NoCorrection(), HallPI(), FeedForward(k), *correctors], SPRING,
-                                            (setting,), **session)
-            by_name = table.set_index("candidate")
-            for name in names:
-                g = goal_table({setting: runs}, name)
-                rows.append({"case": case, "setting": setting, "candidate": name,
-                             "mean_abs_error_rad": by_name.loc[name, "mean_abs_error_rad"],
-                             "cells_met": f"{int(g.meets_goal.sum())}/{len(g)}", "gain_min": g.gain.min(),
-                             "gain_median": g.gain.median(),
-                             "rest_chatter_max_rad": by_name.loc[name, "rest_chatter_rms_max_rad"],
-                             "flagged": bool(g.flagged.any())})
-            print(f"evaluated {case}, {setting}", flush=True)
-    return pd.DataFrame(rows)
+def _paths_us(bundle: Path, calls: int) -> dict[str, float]:
+    """Median single-call latency (us) of the bundle's flat forward on each path (1 torch thread)."""
+    z = np.zeros(len(load_meta(bundle)["inputs"]), dtype=np.float32)
+    npc, onnx, ts = load_numpy(bundle), load_onnx(bundle), load_torchscript(bundle)
+    before = torch.get_num_threads()
+    torch.set_num_threads(1)
+    with torch.inference_mode():
+        zt = torch.from_numpy(z[None, :])
+        ts_us = _median_us(lambda: ts(zt), calls)
+    torch.set_num_threads(before)
+    return {"onnx": _median_us(lambda: onnx(z), calls), "numpy": _median_us(lambda: npc(z), calls), "torchscript": ts_us}
+
+
+def _row(name: str, res: ClosedLoopResult, k: float, calls: int) -> str:
+    bptt_s = sum(row["bptt_s"] for row in res.curve)
+    step_us = _step_us(runtime_corrector(res.policy, k), calls)
+    return (f"{name:<22} {res.settings.lr:>6g} {len(res.curve) - 1:>6} {res.best_epoch:>5} {res.stopped:>10} "
+            f"{res.wall_s:>7.1f} {res.simulated_steps / res.wall_s:>8.0f} {res.trained_steps / bptt_s:>12.0f} "
+            f"{res.curve[res.best_epoch]['val_mean_abs_error_rad']:>11.4f} {res.policy.feedback_lipschitz_bound():>7.3f} "
+            f"{step_us:>7.1f}")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--family1", type=Path, default=None, help="family-1 network (torch.save); trained if absent")
-    ap.add_argument("--evaluate", action="store_true", help="closed-loop goal tables in the knee simulator")
-    ap.add_argument("--threads", type=int, default=1, help="torch intra-op threads for training")
+    ap.add_argument("--spring", type=Path, default=THESIS_SPRING)
+    ap.add_argument("--out", type=Path, default=Path("exports") / "benchmark_closedloop", help="bundles go here")
+    ap.add_argument("--threads", type=int, default=1, help="torch intra-op threads for family-2 training")
     ap.add_argument("--calls", type=int, default=3000, help="runtime latency: command calls timed")
     args = ap.parse_args()
-    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores, {platform.processor() or '?'}; "
-          f"python {platform.python_version()}, torch {torch.__version__}, numpy {np.__version__}, "
-          f"seadesign {__version__}")
-    family1 = _family1(args.family1)
+    spring = load_spring(args.spring)
+    k = spring["k_Nm_per_rad"]
     base = ClosedLoopSettings(threads=args.threads)
-    runs = {"scratch": (base, None)}
-    if family1 is not None:
-        runs["fine-tuned"] = (dataclasses.replace(base, lr=1e-3), family1)
-    knees = len(base.directions) * (len(base.speeds) + len(base.val_speeds)) * len(base.settings) * 2
-    print(f"settings: {len(base.directions)} directions x speeds {base.speeds} (training) and {base.val_speeds} "
-          f"(validation), {base.trial_s:g} s trials, {' and '.join(base.settings)}, noise on, float64 knee; windows "
-          f"of {base.window_steps} samples, feedback Lipschitz bound {base.lipschitz_rad_per_rad} rad/rad, command-"
-          f"rate weight {base.rate_weight_s2:g} s^2; stop: < {base.min_improvement:.0%} for {base.patience} epochs "
-          f"(cap {base.max_seconds:g} s); threads {args.threads}; batch {knees} knees (steps/s: samples of the batch)")
-    print(f"{'run':<11} {'lr':>6} {'epochs':>6} {'best':>5} {'stop':>10} {'wall_s':>7} {'steps/s':>8} "
+    knees = (len(base.directions) * (len(base.speeds) + len(base.val_speeds)) * len(base.settings)
+             * len(base.k_scales) * 2)
+    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores, {platform.processor() or '?'}, "
+          f"load average {os.getloadavg()[0]:.1f}; python {platform.python_version()}, torch {torch.__version__}, "
+          f"numpy {np.__version__}, seadesign {__version__}; spring {args.spring} (k {k:.4g} Nm/rad)")
+    print(f"family 2: {len(base.directions)} directions x speeds {base.speeds} (training) and {base.val_speeds} "
+          f"(validation), {base.trial_s:g} s trials, {' and '.join(base.settings)}, k x {base.k_scales}, noise on, "
+          f"float64 knee; windows of {base.window_steps} samples, feedback Lipschitz bound "
+          f"{base.lipschitz_rad_per_rad} rad/rad, command-rate weight {base.rate_weight_s2:g} s^2; stop: < "
+          f"{base.min_improvement:.0%} for {base.patience} epochs (cap {base.max_seconds:g} s); threads {args.threads}; "
+          f"batch {knees} knees (steps/s: samples of the batch)", flush=True)
+    _, family1, _ = train_reference_bundle(args.spring, args.out / "reference-ilc")
+    family1_s = family1.label_s + family1.training.summary()["wall_s"]
+    print(f"family 1: ILC labels {family1.label_s:.1f} s + network {family1.training.summary()['wall_s']:.1f} s = "
+          f"{family1_s:.0f} s -> {args.out / 'reference-ilc'}", flush=True)
+    print(f"{'run':<22} {'lr':>6} {'epochs':>6} {'best':>5} {'stop':>10} {'wall_s':>7} {'steps/s':>8} "
           f"{'bptt steps/s':>12} {'val_err_rad':>11} {'L_bound':>7} {'step_us':>7}")
-    correctors, names = [], []
-    if family1 is not None:
-        f1 = ReferenceFeedForward(NumpyCorrector(numpy_arrays(family1)), base.window, SPRING["k_Nm_per_rad"],
-                                  name="family1")
-        correctors.append(f1)
-        names.append("family1")
-    for name, (settings, init) in runs.items():
-        res = train_closed_loop(SPRING, settings, init)
-        bptt_s = sum(row["bptt_s"] for row in res.curve)
-        corrector = ClosedLoopCorrector(res.policy, SPRING["k_Nm_per_rad"], name=f"family2 {name}")
-        print(f"{name:<11} {settings.lr:>6g} {len(res.curve) - 1:>6} {res.best_epoch:>5} {res.stopped:>10} "
-              f"{res.wall_s:>7.1f} {res.simulated_steps / res.wall_s:>8.0f} {res.trained_steps / bptt_s:>12.0f} "
-              f"{res.curve[res.best_epoch]['val_mean_abs_error_rad']:>11.4f} "
-              f"{res.policy.feedback_lipschitz_bound():>7.3f} {_latency_us(corrector, args.calls):>7.1f}", flush=True)
-        correctors.append(corrector)
-        names.append(corrector.name)
-    if family1 is not None:
-        print(f"family 1 runtime step: {_latency_us(correctors[0], args.calls):.1f} us")
-    if args.evaluate:
-        pd.set_option("display.width", 200)
-        print(_evaluate(correctors, names).to_string(index=False, float_format=lambda v: f"{v:.4f}"))
+    _, tuned, _ = train_closedloop_bundle(args.spring, args.out / "closedloop", replace(FINE_TUNING, threads=args.threads),
+                                          family1=family1)
+    print(_row("fine-tuned (default)", tuned, k, args.calls), flush=True)
+    scratch = train_closed_loop(spring, base)
+    export_closedloop_bundle(scratch, args.spring, args.out / "closedloop-scratch", {"init": "scratch"},
+                             name="closedloop-scratch")
+    print(_row("scratch", scratch, k, args.calls))
+    paths = _paths_us(args.out / "closedloop", args.calls)
+    print("default bundle, one call of the flat forward (median): " + ", ".join(f"{p} {us:.1f} us" for p, us in
+                                                                              paths.items())
+          + f" (budget {STEP_BUDGET_US:.0f} us: {'within' if max(paths.values()) <= STEP_BUDGET_US else 'OVER'})")
+    print(f"default `seadesign train` (family 1, then fine-tuned): {family1_s + tuned.wall_s:.0f} s to a converged "
+          f"family-2 corrector; from scratch {scratch.wall_s:.0f} s. Bundles in {args.out}. Other processes share "
+          "this CPU.")
 
 
 if __name__ == "__main__":

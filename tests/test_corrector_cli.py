@@ -36,6 +36,17 @@ def test_train_refuses_a_spring_file_that_fails_its_schema(tmp_path, spring_dict
     assert not (tmp_path / "m").exists()
 
 
+def test_train_models_on_recordings_need_data_and_unknown_models_are_named(tmp_path, spring_dict):
+    """The simulator-trained models (closedloop, the default, and reference) run without --data; a model trained
+    on recordings does not, even beside them; an unknown model is refused with the list."""
+    spring = _spring(tmp_path, spring_dict)
+    res = CliRunner().invoke(main, ["train", "--spring", str(spring), "--model", "closedloop,mlp"])
+    assert res.exit_code == 2 and "need --data" in res.output
+    res = CliRunner().invoke(main, ["train", "--spring", str(spring), "--model", "ilc"])
+    assert res.exit_code == 2 and "choose from closedloop, reference, mlp" in res.output
+    assert "default: closedloop" in CliRunner().invoke(main, ["train", "--help"]).output
+
+
 def test_train_then_evaluate_writes_tables_plots_and_json(tmp_path, spring_dict):
     spring = _spring(tmp_path, spring_dict)
     csv = _recording(tmp_path, spring_dict)

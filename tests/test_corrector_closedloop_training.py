@@ -4,14 +4,16 @@ policy; slow: a corrector trained from scratch meets the closed-loop goal in eve
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 import torch
 from conftest import thesis_spring
 
 from seadesign.corrector.closedloop import closed_loop_table, run_closed_loop
-from seadesign.corrector.closedloop_training import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, ClosedLoopCorrector,
-                                                     ClosedLoopPolicy, ClosedLoopSettings, FeedbackBranch,
+from seadesign.corrector.closedloop_training import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, ClosedLoopPolicy,
+                                                     ClosedLoopSettings, FeedbackBranch, _batch, runtime_corrector,
                                                      train_closed_loop, window_policy)
 from seadesign.corrector.goal import goal_table
 from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, reference_features
@@ -84,11 +86,11 @@ def test_feedback_bound_is_reached_by_aligned_weights_and_not_passed():
 
 def test_runtime_is_the_policy_and_mirrors_the_right_knee():
     policy, X = _policy(seed=2, spread=0.5)
-    runtime = ClosedLoopCorrector(policy, 9.106)
+    runtime = runtime_corrector(policy, 9.106)
     m = np.random.default_rng(4).normal(scale=0.1, size=(20, 2))
     with torch.no_grad():
         expected = policy(torch.as_tensor(X[:20], dtype=torch.float32), torch.as_tensor(m, dtype=torch.float32))
-    got = [runtime.policy_command(X[i], m[i]) for i in range(20)]
+    got = [runtime.model.command(X[i], m[i]) for i in range(20)]
     np.testing.assert_allclose(got, expected.numpy(), rtol=1e-5, atol=1e-5)
     preview = Preview(np.linspace(1.0, 1.1, 10), np.full(11, 0.5))
     mirrored = Preview(-preview.target_rad, preview.load_share)
@@ -189,7 +191,7 @@ def test_runtime_in_the_simulator_follows_the_policy_in_the_torch_knee(spring_di
     trials = [Trial("front", 0.15, 3.0), Trial("back_right", 0.1, 3.0)]
     cfg = KneeConfig.from_spring(spring_dict)
     chain = configure_chain(knee_effects(cfg, ground=True), QUIET)
-    run = run_closed_loop(ClosedLoopCorrector(policy, spring_dict["k_Nm_per_rad"]), spring_dict, trials, ground=True,
+    run = run_closed_loop(runtime_corrector(policy, spring_dict["k_Nm_per_rad"]), spring_dict, trials, ground=True,
                           effects=chain)
     assert not run.unstable
     target, stance, x = _walk(spring_dict, trials)
@@ -217,6 +219,27 @@ def test_training_lowers_the_validation_error_and_is_seeded():
     assert [r["val_mean_abs_error_rad"] for r in again.curve] == errors
 
 
+def test_training_batch_runs_each_row_at_its_stiffness_and_tells_the_policy_spring_k():
+    """Rows: per setting and k scale, the trials. At the static start of a hanging knee the spring holds the
+    shank's weight: k x scale x (|deflection| - half the backlash) = |A sin(angle - hip flexion)| (analytic; measured
+    to 1.5e-13 relative, the smoothed dead zone being flat that far out), in each k group with its own scale;
+    every row's k input is spring.json's."""
+    spring = thesis_spring()
+    settings = dataclasses.replace(TINY, k_scales=(0.8, 1.25), noise=False)
+    b = _batch(spring, settings)
+    n = len(settings.trials(settings.speeds)) + len(settings.trials(settings.val_speeds))
+    assert b.target.shape[0] == 2 * 2 * n  # hanging and ground x 2 scales
+    b.knee.reset(b.target[:, 0], b.stance[:, 0])
+    state = b.knee.state()
+    cfg = KneeConfig.from_spring(spring)
+    beyond = (state["qm"] - state["angle"]).abs().numpy() - 0.5 * cfg.backlash_rad  # (rows, 2), flexion
+    gravity = np.abs(cfg.gravity_amplitude_Nm * np.sin(state["angle"].numpy() - cfg.hip_flexion_rad))
+    for group, scale in enumerate((0.8, 1.25)):  # the hanging rows
+        rows = slice(group * n, (group + 1) * n)
+        np.testing.assert_allclose(cfg.k_Nm_per_rad * scale * beyond[rows], gravity[rows], rtol=1e-12)
+    np.testing.assert_array_equal(b.features[..., -1].numpy(), np.float32(spring["k_Nm_per_rad"]))
+
+
 def test_settings_refuse_overlapping_speeds_and_a_wrong_window():
     with pytest.raises(SeadesignError, match="disjoint"):
         ClosedLoopSettings(speeds=(0.1, 0.2), val_speeds=(0.1,))
@@ -231,15 +254,16 @@ SLOW = ClosedLoopSettings(max_epochs=8, max_seconds=float("inf"))
 
 @pytest.mark.slow
 def test_family2_from_scratch_meets_the_closed_loop_goal_in_every_cell():
-    """The corrector trained for `SLOW` meets the goal in all 36 cells of the thesis protocol (18 trials x hanging /
-    ground) against none, PI and the k-feed-forward in the NumPy simulator, with no unstable or oscillating flag.
-    Measured: smallest gain 0.880 hanging, 0.774 ground (goal 0.30); mean |Hall error| 0.0129 rad hanging, 0.0637 rad ground; rest
-    chatter 0.0013 rad (flag 0.02); feedback bound 0.450 rad/rad. The thresholds leave a few times the
-    measured margin."""
+    """The corrector trained for `SLOW` (k x0.8 / 1 / 1.25) meets the goal in all 36 cells of the thesis protocol
+    (18 trials x hanging / ground) against none, PI and the k-feed-forward in the NumPy simulator, with no unstable
+    or oscillating flag. Measured: smallest gain 0.880 hanging, 0.756 ground (goal 0.30); mean |Hall error| 0.0129
+    rad hanging, 0.0719 rad ground; rest chatter 0.0022 rad (flag 0.02); feedback bound 0.500 rad/rad. The
+    thresholds leave a few times the measured margin. (The default, fine-tuning family 1, is held in every case by
+    `test_corrector_reference.py`.)"""
     spring = thesis_spring()
     k = spring["k_Nm_per_rad"]
     res = train_closed_loop(spring, SLOW)
-    corrector = ClosedLoopCorrector(res.policy, k, name="family2")
+    corrector = runtime_corrector(res.policy, k, name="family2")
     runs, rows = {}, {}
     for setting in ("hanging", "ground"):
         table, runs[setting] = closed_loop_table([NoCorrection(), HallPI(), FeedForward(k), corrector], spring,
@@ -248,6 +272,6 @@ def test_family2_from_scratch_meets_the_closed_loop_goal_in_every_cell():
     goal = goal_table(runs, "family2")
     assert len(goal) == 36 and goal.meets_goal.all() and not goal.flagged.any()
     assert goal.gain.min() >= 0.6
-    assert rows["hanging"].mean_abs_error_rad < 0.02 and rows["ground"].mean_abs_error_rad < 0.08
+    assert rows["hanging"].mean_abs_error_rad < 0.02 and rows["ground"].mean_abs_error_rad < 0.09
     assert max(r.rest_chatter_rms_max_rad for r in rows.values()) < 0.005
     assert res.policy.feedback_lipschitz_bound() <= 0.5 + 1e-6  # the stated design bound, rad/rad

@@ -1,12 +1,11 @@
-"""Family 1, the reference-window feed-forward trained on ILC labels: the bundle, and the closed-loop goal
-on trajectories no label used, with the robustness cases."""
+"""Family 1, the reference-window feed-forward trained on ILC labels: the bundle; the simulator check; and the
+closed-loop comparison of family 1 with the default, family 2 fine-tuning it, in every case of the goal."""
 
 from __future__ import annotations
 
 import json
 
 import numpy as np
-import pandas as pd
 import pytest
 import torch
 from click.testing import CliRunner
@@ -14,13 +13,13 @@ from conftest import thesis_spring
 
 from seadesign.corrector.closedloop import run_closed_loop
 from seadesign.corrector.export import NumpyCorrector, load_numpy, load_torchscript, numpy_arrays
-from seadesign.corrector.goal import GOAL_REDUCTION, ROBUST_SHARE, Case, case_table, goal_table, robustness_cases
+from seadesign.corrector.goal import case_table, goal_cases, goal_table, verdict, winner
 from seadesign.corrector.ilc import ILCSettings
 from seadesign.corrector.imitation import ImitationSettings, label_arrays
 from seadesign.corrector.runtime import FeedForward, HallPI, NoCorrection, ReferenceFeedForward
 from seadesign.corrector.workflow import evaluate_bundles, load_corrector, train_reference_bundle
 from seadesign.design.spring import write_spring
-from seadesign.twin import Gait, Trial, thesis_protocol
+from seadesign.twin import Trial, thesis_protocol
 
 SMALL = ImitationSettings(speeds=(0.075, 0.15), settings=("hanging",), k_scales=(1.0,), trial_s=6.0,
                           ilc=ILCSettings(max_iterations=40))
@@ -62,50 +61,59 @@ def meta_check(bundle) -> list:
     return json.loads((bundle / "meta.json").read_text())["simulator_check"]
 
 
-def _goal(runs: dict) -> pd.DataFrame:
-    return goal_table(runs, "reference-ilc")
+#: thresholds of the comparison below, with room for a run cut by its time cap on a slow machine; measured (this
+#: test and benchmarks/closed_loop_goal.py): family 2 keeps >= 0.722 of its nominal gain, family 1 0.699; mean
+#: |Hall error| over cases and settings 0.0535 and 0.0656 rad
+KEPT_SHARE_MIN = 0.6
+FAMILY2_MEAN_RAD = 0.06
 
 
 @pytest.mark.slow
-def test_default_train_meets_the_closed_loop_goal_on_unseen_trajectories_and_robustness_cases(tmp_path):
-    """`seadesign train` (default: the reference family) on the thesis spring; then, in every cell (6 directions x
-    3 speeds x hanging and ground) of the protocol, whose speeds no ILC label used, and of a gait with a shorter
-    cycle: >= 30 % below the best baseline, peak not above it, no flag. In each robustness case: no flag and at
-    least half the nominal gain in every cell. Measured (benchmarks/closed_loop_goal.py), gain min hanging / ground:
-    nominal 0.84 / 0.74, gait 0.86 / 0.70, k x0.7 0.65 / 0.52, k x1.4 0.66 / 0.57, real-knee effects 0.76 / 0.72,
-    softening curve 0.84 / 0.76."""
+def test_default_train_wins_the_comparison_meets_the_goal_and_is_robust(tmp_path):
+    """`seadesign train --model reference,closedloop` on the thesis spring trains family 1 and the default, family 2
+    fine-tuning it (the same network the default trains). Over every case of `goal_cases` (the protocol, whose
+    speeds no training used; a gait with a shorter cycle; k x0.7 and x1.4; real-knee effects; the softening curve),
+    cell by cell (6 directions x 3 speeds x hanging and ground): both meet the goal on the protocol and the gait
+    and are robust in the other cases (no flag, >= half the nominal gain per cell), and family 2 wins (lower mean
+    |Hall error| over the cases), so the default is the winner of the closed-loop comparison."""
     from seadesign.cli import main
 
     spring = thesis_spring()
     path = write_spring(spring, tmp_path / "spring.json")
-    res = CliRunner().invoke(main, ["train", "--spring", str(path), "-o", str(tmp_path / "ref")])
+    res = CliRunner().invoke(main, ["train", "--spring", str(path), "--model", "reference,closedloop",
+                                    "-o", str(tmp_path / "out")])
     assert res.exit_code == 0, res.output
-    corrector, _ = load_corrector(tmp_path / "ref")
-    k = spring["k_Nm_per_rad"]
-    candidates = [NoCorrection(), HallPI(), FeedForward(k), corrector]
-    both = ("hanging", "ground")
-    nominal = _goal(case_table(candidates, spring, Case("nominal"), both, thesis_protocol())[1])
-    assert len(nominal) == 36 and nominal.meets_goal.all(), nominal[~nominal.meets_goal]
-    assert nominal.gain.min() >= GOAL_REDUCTION
-    gait = _goal(case_table(candidates, spring, Case("gait", gait=Gait(cycle_s=0.7)), both, thesis_protocol())[1])
-    assert gait.meets_goal.all(), gait[~gait.meets_goal]
-    for case in robustness_cases(spring):
-        table = _goal(case_table(candidates, spring, case, both, thesis_protocol())[1])
-        assert not table.flagged.any(), case.name
-        keeps = table.gain.to_numpy() >= ROBUST_SHARE * nominal.gain.to_numpy()
-        assert keeps.all(), (case.name, table[~keeps])
+    correctors = [load_corrector(tmp_path / "out" / folder)[0] for folder in ("reference-ilc", "closedloop")]
+    names = [c.name for c in correctors]
+    candidates = [NoCorrection(), HallPI(), FeedForward(spring["k_Nm_per_rad"]), *correctors]
+    goals: dict[str, dict] = {name: {} for name in names}
+    for case in goal_cases(spring):
+        _, runs = case_table(candidates, spring, case, ("hanging", "ground"), thesis_protocol())
+        for name in names:
+            goals[name][case.name] = goal_table(runs, name)
+    assert len(goals["closedloop"]["nominal"]) == 36
+    verdicts = {name: verdict(goals[name]) for name in names}
+    for name, v in verdicts.items():
+        failed = {case: g[~g.meets_goal] for case, g in goals[name].items() if not g.meets_goal.all()}
+        assert v["meets_goal"] and v["robust"] and v["kept_share_min"] >= KEPT_SHARE_MIN, (name, v, failed)
+    assert winner(verdicts) == "closedloop", verdicts
+    assert verdicts["closedloop"]["mean_abs_error_rad"] < FAMILY2_MEAN_RAD
 
 
-@pytest.mark.parametrize("scale", [pytest.param(1.0, marks=pytest.mark.slow), 2.0])
-def test_simulator_check_reads_the_robots_stiffness_from_its_recording(tmp_path, scale):
-    """A recording simulated with the spring's stiffness x `scale`: the check recovers the scale and says whether
-    it lies in the range the corrector is tested for (0.7-1.4)."""
+@pytest.mark.parametrize("scale,offset_rad", [pytest.param(1.0, 0.0, marks=pytest.mark.slow), (2.0, 0.0),
+                                              pytest.param(1.0, 0.05, marks=pytest.mark.slow)])
+def test_simulator_check_reads_the_robots_stiffness_and_hall_offset_from_its_recording(tmp_path, scale, offset_rad):
+    """A recording simulated with the spring's stiffness x `scale` and a Hall offset: the check recovers the scale,
+    says whether it lies in the range the corrector is tested for (0.7-1.4), and finds a Hall offset exactly when
+    there is one (the hanging shank's sag at rest, 0.048 rad, is no offset: the cleaning used to make it one)."""
     from seadesign.corrector.simcheck import check_simulator
     from seadesign.data import write_recording
     from seadesign.twin import KneeConfig, KneeSession, knee_effects
 
     spring = thesis_spring()
     chain = knee_effects(KneeConfig.from_spring(spring)).configure("stiffness_scale", enabled=True, scale=scale)
+    if offset_rad:
+        chain = chain.configure("hall_offset", enabled=True, offset_rad=offset_rad)
     session = KneeSession(spring, [Trial("front", 0.1, 15.0), Trial("right", 0.2, 15.0)], effects=chain)
     path = write_recording(session.run(), tmp_path / "walk.csv", metadata=session.metadata())
     checks = check_simulator(spring, [path])
@@ -113,3 +121,4 @@ def test_simulator_check_reads_the_robots_stiffness_from_its_recording(tmp_path,
     for c in checks:
         assert c.stiffness_scale == pytest.approx(scale, rel=0.06)  # measured 1.8-3 % low
         assert c.within_robust_range == (scale == 1.0)
+        assert c.found == (("sensor_offset",) if offset_rad else ())

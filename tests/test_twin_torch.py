@@ -287,3 +287,28 @@ def test_robot_frame_mirrors_the_right_knee():
     x = torch.tensor([[0.3, 0.4]], dtype=torch.float64)
     assert torch.equal(to_robot(x), torch.tensor([[0.3, -0.4]], dtype=torch.float64))
     assert torch.equal(to_robot(to_robot(x)), x)
+
+
+def test_stiffness_scale_varies_across_the_batch_as_one_session_per_scale(spring_dict):
+    """One torch knee whose trials carry stiffness scales 0.8 / 1 / 1.25 (`vary`) gives each trial what a KneeSession
+    with that scale gives (to the tolerances above); other values and absent effects are refused by name."""
+    trials = [Trial("front", 0.15, 3.0), Trial("back_right", 0.1, 3.0)]
+    scales = (0.8, 1.0, 1.25)
+    sessions = [_session(spring_dict, True, [f"stiffness_scale:scale={s}"], trials=trials) for s in scales]
+    refs = [_record(s) for s in sessions]
+    cfg = KneeConfig.from_spring(spring_dict)
+    chain = configure_chain(knee_effects(cfg, True), QUIET + ["stiffness_scale"])
+    knee = TorchKnee(cfg, chain)
+    knee.vary("stiffness_scale", scale=torch.tensor(scales).repeat_interleave(len(trials))[:, None])
+    stance = torch.as_tensor(np.concatenate([s.stance for s in sessions]))
+    command = torch.as_tensor(np.concatenate([r["command"] for r in refs]))
+    knee.reset(command[:, 0], stance[:, 0])
+    with torch.no_grad():
+        hall = rollout(knee, lambda obs, k: command[:, k], stance, command.shape[1])["hall_rad"].numpy()
+    expected = np.concatenate([r["hall"] for r in refs])
+    assert np.abs(hall - expected).max() < MAX_ERROR["hall"]
+    assert np.abs(expected[:2] - expected[4:]).max() > 0.01  # the scales do differ
+    with pytest.raises(ConfigError, match="cannot vary \\['k_Nm_per_rad'\\]"):
+        knee.vary("stiffness_scale", k_Nm_per_rad=torch.ones(1))
+    with pytest.raises(ConfigError, match="no enabled effect 'viscoelastic'"):
+        knee.vary("viscoelastic", maxwell_stiffness_Nm_per_rad=torch.ones(1))

@@ -13,14 +13,16 @@ from seadesign.corrector.iterative import iterate as run_iterations
 from seadesign.corrector.models import MODEL_KINDS
 from seadesign.corrector.recordings import load_recordings
 from seadesign.corrector.report import write_table
+from seadesign.corrector.simcheck import check_simulator
 from seadesign.corrector.splits import SPLITS
 from seadesign.corrector.train import TrainConfig
-from seadesign.corrector.workflow import DEFAULT_HISTORY, candidate_name, evaluate_bundles, train_bundle, train_reference_bundle
+from seadesign.corrector.workflow import (DEFAULT_HISTORY, PREVIEW_MODELS, candidate_name, evaluate_bundles,
+                                          train_bundle, train_closedloop_bundle, train_reference_bundle)
 from seadesign.design.spring import load_spring
 from seadesign.twin import thesis_protocol
 
 
-TRAIN_KINDS = ("reference", *MODEL_KINDS)
+TRAIN_KINDS = (*PREVIEW_MODELS, *MODEL_KINDS)
 
 
 def _models(text: str) -> list[str]:
@@ -31,16 +33,27 @@ def _models(text: str) -> list[str]:
     return models
 
 
+def _echo_checks(checks: list) -> None:
+    """The simulator check's lines, and a warning when the robot's k is outside the tested range."""
+    for c in checks:
+        click.echo(("" if c.within_robust_range else "WARNING: ") + "simulator check: " + c.text())
+    if any(not c.within_robust_range for c in checks):
+        click.echo("WARNING: the robot's k is outside what this corrector was tested for; calibrate "
+                   "spring.json first (seadesign explain, then sweep --calibration)")
+
+
 @main.command()
 @click.option("--spring", "spring_path", required=True, type=click.Path(dir_okay=False),
               help="spring.json from `seadesign sweep` (k is read from it; the file must pass its schema)")
 @click.option("--data", "data", multiple=True, type=click.Path(exists=True, dir_okay=False),
-              help="robot recording CSV (repeat for several files); trains every model but 'reference', which uses "
-                   "them to check its simulator (k and effects, by the loop)")
-@click.option("--model", "model_text", default="reference", show_default=True,
-              help=f"one or more of {', '.join(TRAIN_KINDS)}, comma-separated. reference: feed-forward from the "
-                   "walk engine's trajectory, trained on iterative-learning-control labels in the knee simulator "
-                   "(no measured state in the loop: the family that is stable in closed loop)")
+              help="robot recording CSV (repeat for several files); trains the models on recordings; for 'closedloop' "
+                   "and 'reference' it checks their simulator against the robot (k and effects, by the loop)")
+@click.option("--model", "model_text", default="closedloop", show_default=True,
+              help=f"one or more of {', '.join(TRAIN_KINDS)}, comma-separated. closedloop (the one that wins in "
+                   "closed loop): the reference network below, fine-tuned through the closed loop in the knee "
+                   "simulator with a feedback on the Hall error whose gain is bounded (0.5 rad/rad). reference: "
+                   "feed-forward from the walk engine's trajectory, trained on iterative-learning-control labels "
+                   "in the knee simulator. Both are trained over k x0.8-1.25 and read no recorded state")
 @click.option("--modalities", default="velocity_effort", show_default=True,
               help="a thesis combination name (target_only, velocity_effort, all, ...) or a comma-separated "
                    "list of motor_pos, hall_pos, motor_vel, hall_vel, effort, imu, pressure")
@@ -63,29 +76,39 @@ def _models(text: str) -> list[str]:
 def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: str, task: str, positive: bool,
           history: int | None, split_name: str, test_recording: tuple[str, ...], seed: int, max_epochs: int,
           patience: int, max_seconds: float, batch_size: int, lr: float, out: str | None) -> None:
-    """Train corrector network(s) and export bundles (TorchScript, ONNX, NumPy): by default the reference-window
-    feed-forward on ILC labels from the knee simulator built from spring.json; models on recordings with --model."""
+    """Train corrector network(s) and export bundles (TorchScript, ONNX, NumPy): by default the closed-loop corrector
+    trained in the knee simulator built from spring.json; models on recordings with --model."""
     models = _models(model_text)
     spring = load_spring(spring_path)
-    if not data and any(m != "reference" for m in models):
+    on_data = [m for m in models if m not in PREVIEW_MODELS]
+    if not data and on_data:
         raise click.BadParameter("models trained on recordings need --data FILE (repeat for several files)")
-    recs = load_recordings(list(data)) if any(m != "reference" for m in models) else []  # reference: simcheck reads them
+    recs = load_recordings(list(data)) if on_data else []  # the preview models' simulator check reads the files
     cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=max_seconds,
                       batch_size=batch_size, lr=lr)
     root = Path(out) if out else Path("exports") / spring["study"] / "corrector"
-    for model in models:
-        if model == "reference":
-            target = root if (out and len(models) == 1) else root / "reference-ilc"
-            path, ref, checks = train_reference_bundle(spring_path, target, data_paths=list(data))
-            for c in checks:
-                click.echo(("" if c.within_robust_range else "WARNING: ") + "simulator check: " + c.text())
-            if any(not c.within_robust_range for c in checks):
-                click.echo("WARNING: the robot's k is outside what this corrector was tested for; calibrate "
-                           "spring.json first (seadesign explain, then sweep --calibration)")
-            s = ref.summary()["training"]
-            click.echo(f"reference-ilc: ILC labels {ref.label_s:.0f} s ({len(ref.labels)} batches); best validation MSE "
-                       f"{s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} ({s['stopped']}, {s['wall_s']:.1f} s) "
-                       f"-> {path}")
+    checks = check_simulator(spring, list(data)) if set(models) & set(PREVIEW_MODELS) else []
+    _echo_checks(checks)
+    family1 = None
+    for model in sorted(models, key=lambda m: m != "reference"):  # family 1 first: family 2 fine-tunes it
+        if model in PREVIEW_MODELS:
+            folder = {"reference": "reference-ilc", "closedloop": "closedloop"}[model]
+            target = root if (out and len(models) == 1) else root / folder
+            if model == "reference":
+                path, family1, _ = train_reference_bundle(spring_path, target, data_paths=list(data), checks=checks)
+                s = family1.summary()["training"]
+                summary = (f"ILC labels {family1.label_s:.0f} s ({len(family1.labels)} batches); best validation MSE "
+                           f"{s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} ({s['stopped']}, "
+                           f"{s['wall_s']:.1f} s)")
+            else:
+                path, res, _ = train_closedloop_bundle(spring_path, target, family1=family1, data_paths=list(data),
+                                                       checks=checks)
+                s = res.summary()
+                summary = (f"fine-tuned through the closed loop: validation mean |Hall error| "
+                           f"{s['best_val_mean_abs_error_rad']:.4f} rad at epoch {s['best_epoch']} ({s['stopped']}, "
+                           f"{s['wall_s']:.1f} s); feedback gain bound {s['feedback_lipschitz_bound_rad_per_rad']:.3f} "
+                           "rad/rad")
+            click.echo(f"{model}: {summary} -> {path}")
             continue
         h = history if history is not None else (DEFAULT_HISTORY if model == "history" else 0)
         spec = DatasetSpec(task, modalities, h, positive)

@@ -2,9 +2,12 @@
 
 Flow: recordings -> `build_dataset` (task, modalities, history, positive) -> `make_split`
 (time blocks / by recording / the thesis's random 80/20) -> `fit` -> `export_bundle`
-(TorchScript + NumPy) -> open-loop (`open_loop_table`) and closed-loop (`closed_loop_table`, knee
+(TorchScript, ONNX, NumPy) -> open-loop (`open_loop_table`) and closed-loop (`closed_loop_table`, knee
 simulator) evaluation against the baselines; `iterate` retrains on runs with the corrector in the
-loop. `train_bundle` / `evaluate_bundles` are the CLI's workflows.
+loop. The correctors that work in closed loop learn in the knee simulator instead: family 1 on ILC
+labels (`imitation`), family 2 (the default) fine-tuning it through the loop (`closedloop_training`).
+`train_bundle` / `train_reference_bundle` / `train_closedloop_bundle` / `evaluate_bundles` (`workflow`)
+are the CLI's workflows.
 """
 
 from seadesign.corrector.closedloop import ClosedLoopRun, closed_loop_table, run_closed_loop

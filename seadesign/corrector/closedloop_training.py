@@ -25,12 +25,14 @@ bound is not covered by a theorem here, which is why training also keeps only ep
 
 Training (`train_closed_loop`): the training trials (every walk direction at `imitation.TRAIN_SPEEDS`,
 not the protocol's speeds) and the validation trials (every direction at `VAL_SPEEDS`) run hanging and
-on the ground in one batched torch knee (the ground chain; a hanging trial carries no stance load), noise
-on, so the feedback meets the sensor noise it must not amplify. Each epoch: one pass without gradients
-over whole trials records the state at each window start and scores the validation trials (mean |Hall
-error|, rad); then BPTT through the truncated windows of `window_steps` samples (all, or
-`windows_per_epoch` of them, in a seeded random order), each from its recorded start, one Adam step
-per window on
+on the ground, each with the spring's stiffness scaled by every one of `k_scales` (`imitation.TRAIN_K_SCALES`,
+0.8 / 1 / 1.25), in one batched torch knee (the ground chain; a hanging trial carries no stance load), noise
+on, so the feedback meets the sensor noise it must not amplify. The policy's k input stays spring.json's in
+every row: like the robot, it is not told the true stiffness, and learns a command that serves the range.
+Each epoch: one pass without gradients over whole trials records the state at each window start and
+scores the validation trials (mean |Hall error|, rad); then BPTT through the truncated windows of
+`window_steps` samples (all, or `windows_per_epoch` of them, in a seeded random order), each from its
+recorded start, one Adam step per window on
 
     loss = mean (target - hall)^2 [rad^2] + `rate_weight_s2` * mean (d(command - target)/dt)^2 [(rad/s)^2]
 
@@ -59,12 +61,11 @@ from torch import nn
 from torch.nn.utils import parametrize
 
 from seadesign.corrector.closedloop import CHATTER_RMS_RAD, chatter_rms
-from seadesign.corrector.dataset import KNEES
-from seadesign.corrector.export import LEAKY_SLOPE
-from seadesign.corrector.imitation import TRAIN_SPEEDS
+from seadesign.corrector.export import NumpyClosedLoop
+from seadesign.corrector.imitation import TRAIN_K_SCALES, TRAIN_SPEEDS
 from seadesign.corrector.models import CorrectorNet, MLPCore
-from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, knee_window, reference_features
-from seadesign.data import KNEE_SIGN_BY_NAME
+from seadesign.corrector.reference import ReferenceWindow, reference_features
+from seadesign.corrector.runtime import ClosedLoopCorrector
 from seadesign.errors import SeadesignError
 from seadesign.twin import Trial
 from seadesign.twin.config import KneeConfig, knee_effects
@@ -198,6 +199,7 @@ class ClosedLoopSettings:
     val_speeds: tuple[float, ...] = VAL_SPEEDS
     directions: tuple[str, ...] = tuple(DIRECTIONS)
     settings: tuple[str, ...] = ("hanging", "ground")
+    k_scales: tuple[float, ...] = TRAIN_K_SCALES
     trial_s: float = 10.0
     rate_hz: float = 100.0
     gait: Gait = Gait()
@@ -226,6 +228,8 @@ class ClosedLoopSettings:
                                  "max_epochs >= 1")
         if self.rate_weight_s2 < 0 or self.lr <= 0 or self.min_improvement < 0 or not 0 < self.lr_decay <= 1:
             raise SeadesignError("rate_weight_s2 and min_improvement must be >= 0, lr > 0, lr_decay in (0, 1]")
+        if not self.k_scales or min(self.k_scales) <= 0:
+            raise SeadesignError(f"k_scales must be non-empty and > 0, got {self.k_scales}")
         if not self.speeds or not self.val_speeds or set(self.speeds) & set(self.val_speeds):
             raise SeadesignError(f"training speeds {self.speeds} and validation speeds {self.val_speeds} must be "
                                  "non-empty and disjoint")
@@ -235,6 +239,11 @@ class ClosedLoopSettings:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+
+#: settings for fine-tuning a family-1 network (the default corrector): Adam's step a tenth of the from-scratch
+#: one, as the feed-forward starts trained
+FINE_TUNING = ClosedLoopSettings(lr=1e-3)
 
 
 @dataclass
@@ -275,18 +284,23 @@ class _Batch:
 
 
 def _batch(spring: dict, s: ClosedLoopSettings) -> _Batch:
+    """Rows: for each setting and k scale, the training then the validation trials. The knee's stiffness is
+    scaled per row; the policy's k input stays spring.json's (the corrector is not told the robot's k)."""
     train, val = s.trials(s.speeds), s.trials(s.val_speeds)
     _, target, stance = protocol_tensors(train + val, s.rate_hz, s.gait)
-    n = len(train) + len(val)
-    target = target.repeat(len(s.settings), 1, 1)
-    ground = torch.tensor([float(st == "ground") for st in s.settings]).repeat_interleave(n)
-    stance = stance.repeat(len(s.settings), 1, 1) * ground[:, None, None]
+    n, groups = len(train) + len(val), [(st, scale) for st in s.settings for scale in s.k_scales]
+    target = target.repeat(len(groups), 1, 1)
+    ground = torch.tensor([float(st == "ground") for st, _ in groups]).repeat_interleave(n)
+    scale = torch.tensor([scale for _, scale in groups], dtype=torch.float64).repeat_interleave(n)
+    stance = stance.repeat(len(groups), 1, 1) * ground[:, None, None]
     k = float(spring["k_Nm_per_rad"])
     feats = reference_features(np.moveaxis(target.numpy(), 2, 1), np.moveaxis(stance.numpy(), 2, 1), k, s.window)
     rows = torch.arange(len(target))
     is_val = (rows % n) >= len(train)
     config = KneeConfig.from_spring(spring)
-    knee = TorchKnee(config, knee_effects(config, ground=True), rate_hz=s.rate_hz, noise=s.noise, seed=s.seed)
+    knee = TorchKnee(config, knee_effects(config, ground=True).configure("stiffness_scale", enabled=True),
+                     rate_hz=s.rate_hz, noise=s.noise, seed=s.seed)
+    knee.vary("stiffness_scale", scale=scale[:, None])
     return _Batch(knee, target, stance, torch.as_tensor(np.moveaxis(feats, 1, 2), dtype=torch.float32),
                   rows[~is_val], rows[is_val])
 
@@ -418,59 +432,61 @@ def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> Cl
     return ClosedLoopResult(policy, s, curve, best_epoch, stopped, time.perf_counter() - t0, simulated, trained)
 
 
-# -- runtime -------------------------------------------------------------------------------------------------
-class ClosedLoopCorrector:
-    """The trained policy in NumPy (float64) for `run_closed_loop`: reference window (`reference.ReferenceBuffer`) from the
-    walk engine's preview, Hall error and its rate from `measured` (robot frame in and out, the right knee mirrored).
-    `k_Nm_per_rad`: the spring's stiffness from spring.json (a reference-window input). The input
-    standardisation is folded into the first layers, and the feed-forward's and the feedback's first layers
-    on the window are one matrix."""
+# -- export --------------------------------------------------------------------------------------------------
+#: names of the measured inputs m after the reference window in an exported policy's flat input (rad)
+MEASURED_INPUTS = ("hall_error_rad", "scaled_hall_error_rate_rad")
 
-    def __init__(self, policy: ClosedLoopPolicy, k_Nm_per_rad: float, name: str = "closed_loop") -> None:
-        self.window, self.k, self.name = policy.window, float(k_Nm_per_rad), name
-        self.preview_steps = policy.window.preview
-        arr = lambda t: t.detach().double().numpy().copy()  # noqa: E731
-        ff, fb = policy.ff, policy.feedback
-        ff_layers = [arr(m.weight) for m in ff.core.body if isinstance(m, nn.Linear)]
-        ff_biases = [arr(m.bias) for m in ff.core.body if isinstance(m, nn.Linear)]
-        inv_std, mean = 1.0 / arr(ff.x_std), arr(ff.x_mean)
-        first = np.concatenate([ff_layers[0], arr(fb.x_in.weight)]) * inv_std
-        self.first_W = first
-        self.first_b = np.concatenate([ff_biases[0], arr(fb.x_in.bias)]) - first @ mean
-        self.n_ff = ff_layers[0].shape[0]
-        self.ff_hidden = list(zip(ff_layers[1:], ff_biases[1:]))
-        y_std = float(ff.y_std)
-        self.ff_out_W = y_std * arr(ff.core.out.weight)[0]
-        self.ff_out_b = y_std * float(arr(ff.core.out.bias)[0]) + float(ff.y_mean)
-        self.base_w = arr(ff.base_w)
-        self.m_W = arr(fb.m_in.weight)
-        self.fb_hidden = [(arr(h.weight), arr(h.bias)) for h in fb.hidden]
-        self.fb_out_W = policy.lipschitz_rad_per_rad * arr(fb.out.weight)[0]
-        self.reset()
 
-    def reset(self) -> None:
-        self._buffers = {k: ReferenceBuffer(self.window, self.k) for k in KNEES}
-        self._prev_target: dict[str, float | None] = {k: None for k in KNEES}
+def _plain(layer: nn.Linear) -> nn.Linear:
+    """A plain linear layer with `layer`'s current (evaluated) weight and bias."""
+    out = nn.Linear(layer.in_features, layer.out_features, bias=layer.bias is not None)
+    with torch.no_grad():
+        out.weight.copy_(layer.weight)
+        if layer.bias is not None:
+            out.bias.copy_(layer.bias)
+    return out
 
-    def policy_command(self, x: np.ndarray, m: np.ndarray) -> float:
-        """ff(x) + L [h(m, x) - h(0, x)] (rad) for one reference window x (d,) and measured inputs m (2,) rad."""
-        a = self.first_W @ x + self.first_b
-        z = a[: self.n_ff]
-        z = np.maximum(z, LEAKY_SLOPE * z)
-        for W, bias in self.ff_hidden:
-            z = W @ z + bias
-            z = np.maximum(z, LEAKY_SLOPE * z)
-        ctx = a[self.n_ff:]
-        h, h0 = np.tanh(self.m_W @ m + ctx), np.tanh(ctx)
-        for W, bias in self.fb_hidden:
-            h, h0 = np.tanh(W @ h + bias), np.tanh(W @ h0 + bias)
-        return float(x @ self.base_w + self.ff_out_W @ z + self.ff_out_b + self.fb_out_W @ (h - h0))
 
-    def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float,
-                preview: Preview | None = None) -> float:
-        sign = KNEE_SIGN_BY_NAME[knee]
-        target, x = knee_window(self._buffers[knee], sign, target_rad, preview, self.name)
-        prev = self._prev_target[knee]
-        self._prev_target[knee] = target
-        rate = (0.0 if prev is None else (target - prev) / dt_s) - sign * measured["hall_vel_rad_per_s"]
-        return sign * self.policy_command(x, np.array([target - sign * measured["hall_pos_rad"], RATE_TIME_S * rate]))
+class FlatPolicy(nn.Module):
+    """The policy for export (TorchScript, ONNX): one raw input z = [x, m] (B, d + 2) -> command (B,) rad, flexion;
+    a float32 copy whose bounded weights are evaluated once (plain linear layers and tanh; the bound holds)."""
+
+    def __init__(self, policy: ClosedLoopPolicy) -> None:
+        super().__init__()
+        plain = copy.deepcopy(policy).float().eval()
+        fb = plain.feedback  # new layers, not remove_parametrizations: a deep copy shares the parametrised class
+        fb.m_in, fb.out = _plain(fb.m_in), _plain(fb.out)
+        fb.hidden = nn.ModuleList(_plain(layer) for layer in fb.hidden)
+        self.policy, self.d = plain, int(plain.ff.x_mean.shape[0])
+
+    def forward(self, z: torch.Tensor) -> torch.Tensor:
+        return self.policy(z[..., : self.d], z[..., self.d:])
+
+
+def policy_arrays(policy: ClosedLoopPolicy) -> dict[str, np.ndarray]:
+    """The policy as float64 arrays for `export.NumpyClosedLoop`: the input standardisation folded into the first
+    layers, the feed-forward's and the feedback's first layers on the window stacked, y_std and y_mean folded into
+    the feed-forward's output, L into the feedback's; `rate_time_s` (s) of the rate input."""
+    arr = lambda t: t.detach().double().numpy().copy()  # noqa: E731
+    ff, fb = policy.ff, policy.feedback
+    lin = [m for m in ff.core.body if isinstance(m, nn.Linear)]
+    inv_std, mean = 1.0 / arr(ff.x_std), arr(ff.x_mean)
+    first = np.concatenate([arr(lin[0].weight), arr(fb.x_in.weight)]) * inv_std
+    y_std = float(ff.y_std)
+    out = {"first_W": first, "first_b": np.concatenate([arr(lin[0].bias), arr(fb.x_in.bias)]) - first @ mean,
+           "n_ff": np.array(lin[0].weight.shape[0]), "n_ff_hidden": np.array(len(lin) - 1),
+           "n_fb_hidden": np.array(len(fb.hidden)), "base_w": arr(ff.base_w),
+           "ff_out_W": y_std * arr(ff.core.out.weight)[0],
+           "ff_out_b": y_std * arr(ff.core.out.bias)[0] + float(ff.y_mean),
+           "m_W": arr(fb.m_in.weight), "fb_out_W": policy.lipschitz_rad_per_rad * arr(fb.out.weight)[0],
+           "rate_time_s": np.array(RATE_TIME_S)}
+    for i, layer in enumerate(lin[1:]):
+        out[f"ff_W{i}"], out[f"ff_b{i}"] = arr(layer.weight), arr(layer.bias)
+    for i, layer in enumerate(fb.hidden):
+        out[f"fb_W{i}"], out[f"fb_b{i}"] = arr(layer.weight), arr(layer.bias)
+    return out
+
+
+def runtime_corrector(policy: ClosedLoopPolicy, k_Nm_per_rad: float, name: str = "closedloop") -> ClosedLoopCorrector:
+    """The policy as a bundle runs it (`ClosedLoopCorrector` on the NumPy path); k from spring.json."""
+    return ClosedLoopCorrector(NumpyClosedLoop(policy_arrays(policy)), policy.window, k_Nm_per_rad, name)

@@ -9,6 +9,9 @@ best baseline mean (the share of the best baseline's error removed).
 Robustness (`robustness_cases`): the same corrector, unchanged, in simulators that differ from the one
 it was trained for; it must stay unflagged and keep at least `ROBUST_SHARE` of its nominal gain in
 every cell. Effect sizes are stated physical ranges (see `robustness_cases`).
+
+`goal_cases` lists every case the goal is judged in (nominal, a held-out gait, the robustness cases) and
+`verdict` condenses one candidate's goal tables over them; `winner` picks among candidates by that.
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from seadesign.twin import Gait, KneeConfig, Trial, knee_effects
 GOAL_REDUCTION = 0.30
 ROBUST_SHARE = 0.5
 BASELINES = ("none", "pi", "feedforward")
+HELD_OUT_CASE = "gait 0.7 s cycle"
 
 
 @dataclass(frozen=True)
@@ -63,6 +67,37 @@ def robustness_cases(spring: dict[str, Any]) -> list[Case]:
             "hall_delay": {"delay_s": 0.01}, "effort_lag": {"time_constant_s": 0.02}}
     return [Case("k x0.7", {"stiffness_scale": {"scale": 0.7}}), Case("k x1.4", {"stiffness_scale": {"scale": 1.4}}),
             Case("real-knee effects", real), Case("curve" if torque_curve(spring) is None else "k", law="swap")]
+
+
+def goal_cases(spring: dict[str, Any]) -> list[Case]:
+    """Every case of the goal: the thesis protocol ("nominal"), a gait no training used (cycle 0.7 s instead of
+    0.8 s, "gait 0.7 s cycle"; both judged on the goal itself), then the `robustness_cases`."""
+    return [Case("nominal"), Case(HELD_OUT_CASE, gait=Gait(cycle_s=0.7)), *robustness_cases(spring)]
+
+
+def verdict(goals: dict[str, pd.DataFrame]) -> dict[str, Any]:
+    """One candidate over `goal_cases`: `goals` maps case name -> its `goal_table` (same cells in the same order).
+    meets_goal: every cell of "nominal" and the held-out gait meets the goal; robust: in every other case no
+    flag and each cell keeps >= `ROBUST_SHARE` of its nominal gain; kept_share_min: the smallest such share (1);
+    mean_abs_error_rad: mean over cases and settings of the mean |Hall error| (rad)."""
+    nominal = goals["nominal"].gain.to_numpy()
+    meets, robust, kept = True, True, float("inf")
+    for name, g in goals.items():
+        if name in ("nominal", HELD_OUT_CASE):
+            meets &= bool(g.meets_goal.all())
+            continue
+        share = g.gain.to_numpy() / nominal
+        kept = min(kept, float(share.min()))
+        robust &= not bool(g.flagged.any()) and bool((share >= ROBUST_SHARE).all())
+    errors = [g.groupby("setting").mean_abs_error_rad.mean().mean() for g in goals.values()]
+    return {"meets_goal": meets, "robust": robust, "kept_share_min": kept,
+            "mean_abs_error_rad": float(np.mean(errors))}
+
+
+def winner(verdicts: dict[str, dict[str, Any]]) -> str | None:
+    """The candidate that meets the goal and is robust with the lowest `mean_abs_error_rad`; None if none does."""
+    fit = {name: v["mean_abs_error_rad"] for name, v in verdicts.items() if v["meets_goal"] and v["robust"]}
+    return min(fit, key=fit.get) if fit else None
 
 
 def case_table(correctors: list[Corrector], spring: dict[str, Any], case: Case, settings: tuple[str, ...],

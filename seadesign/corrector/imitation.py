@@ -28,6 +28,8 @@ from seadesign.twin.walk import DIRECTIONS, Gait
 
 #: walk speeds of the ILC labels (m/s): around and between the protocol's 0.05 / 0.1 / 0.2, none equal
 TRAIN_SPEEDS = (0.03, 0.075, 0.15, 0.25)
+#: stiffness scales the simulator is trained at (1): inside the robustness range 0.7-1.4 (`goal.robustness_cases`)
+TRAIN_K_SCALES = (0.8, 1.0, 1.25)
 
 
 @dataclass(frozen=True)
@@ -37,7 +39,7 @@ class ImitationSettings:
     window: ReferenceWindow = ReferenceWindow()
     speeds: tuple[float, ...] = TRAIN_SPEEDS
     settings: tuple[str, ...] = ("hanging", "ground")
-    k_scales: tuple[float, ...] = (0.8, 1.0, 1.25)
+    k_scales: tuple[float, ...] = TRAIN_K_SCALES
     trial_s: float = 10.0
     rate_hz: float = 100.0
     gait: Gait = Gait()

@@ -87,14 +87,23 @@ def plot_predictions(traces: dict[str, dict], out_path: str | Path, knee: int = 
     return Path(out_path)
 
 
+#: validation scores of training curves: column -> axis label
+CURVE_SCORES = {"val_mse_rad2": "validation MSE (rad^2)",
+                "val_mean_abs_error_rad": "closed-loop validation mean |Hall error| (rad)"}
+
+
 def plot_curves(curves: dict[str, list[dict]], out_path: str | Path) -> Path:
-    """Validation MSE (rad^2) per epoch for each trained candidate."""
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for name, curve in curves.items():
-        ax.semilogy([r["epoch"] for r in curve], [r["val_mse_rad2"] for r in curve], label=name)
-    ax.set_xlabel("epoch")
-    ax.set_ylabel("validation MSE (rad^2)")
-    ax.legend(fontsize=7)
+    """Validation score per epoch for each trained candidate, one panel per score: the MSE (rad^2) of networks
+    trained on labels or recordings, the closed-loop mean |Hall error| (rad) of those trained through the loop."""
+    used = [c for c in CURVE_SCORES if any(curve and c in curve[0] for curve in curves.values())] or list(CURVE_SCORES)[:1]
+    fig, axes = plt.subplots(1, len(used), figsize=(7 * len(used), 4), squeeze=False)
+    for ax, score in zip(axes[0], used):
+        for name, curve in curves.items():
+            if curve and score in curve[0]:
+                ax.semilogy([r["epoch"] for r in curve], [r[score] for r in curve], label=name)
+        ax.set_xlabel("epoch")
+        ax.set_ylabel(CURVE_SCORES[score])
+        ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out_path, dpi=110)
     plt.close(fig)

@@ -15,6 +15,8 @@ frame, SI). `reset()` clears internal state between trials.
 - `ReferenceFeedForward`: a network on the reference window only (`reference.py`), plus an optional
   low-gain PI on the Hall error; it reads the walk engine's preview (`preview_steps` > 0), which the
   closed loop passes as `preview=`.
+- `ClosedLoopCorrector`: a policy trained through the closed loop (`closedloop_training`): the same
+  reference window plus a feedback on the Hall error and its rate, its gain bounded by construction.
 """
 
 from __future__ import annotations
@@ -24,11 +26,14 @@ from typing import Protocol
 import numpy as np
 
 from seadesign.corrector.dataset import KNEES, DatasetSpec, FeatureBuilder
-from seadesign.corrector.export import NumpyCorrector
+from seadesign.corrector.export import NumpyClosedLoop, NumpyCorrector
 from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, knee_window
 from seadesign.data import KNEE_SIGN_BY_NAME
 from seadesign.design.spring import TorqueCurve
 from seadesign.errors import SeadesignError
+
+#: single-call latency budget of a corrector (us): it has to fit a 1 kHz robot loop (measured in benchmarks/)
+STEP_BUDGET_US = 50.0
 
 
 class Corrector(Protocol):
@@ -139,3 +144,31 @@ class ReferenceFeedForward:
         e = target - sign * measured["hall_pos_rad"]
         self._integral[knee] += e * dt_s
         return sign * (float(self.model(x)) + self.kp * e + self.ki * self._integral[knee])
+
+
+class ClosedLoopCorrector:
+    """command = ff(x) + L [h(m, x) - h(0, x)] (`export.NumpyClosedLoop`; flexion, the right knee mirrored in and
+    out): x the reference window kept here from the walk engine's preview (as `ReferenceFeedForward`), m the Hall
+    error e = target - hall and its rate (the target's finite difference minus the measured Hall velocity) times
+    the policy's `rate_time_s`, both rad."""
+
+    def __init__(self, model: NumpyClosedLoop, window: ReferenceWindow, k_Nm_per_rad: float,
+                 name: str = "closedloop") -> None:
+        self.model, self.window, self.k, self.name = model, window, float(k_Nm_per_rad), name
+        self.preview_steps = window.preview
+        self._m = np.empty(2)
+        self.reset()
+
+    def reset(self) -> None:
+        self._buffers = {k: ReferenceBuffer(self.window, self.k) for k in KNEES}
+        self._prev_target: dict[str, float | None] = {k: None for k in KNEES}
+
+    def command(self, knee: str, target_rad: float, measured: dict[str, float], dt_s: float,
+                preview: Preview | None = None) -> float:
+        sign = KNEE_SIGN_BY_NAME[knee]
+        target, x = knee_window(self._buffers[knee], sign, target_rad, preview, self.name)
+        prev = self._prev_target[knee]
+        self._prev_target[knee] = target
+        rate = (0.0 if prev is None else (target - prev) / dt_s) - sign * measured["hall_vel_rad_per_s"]
+        self._m[0], self._m[1] = target - sign * measured["hall_pos_rad"], self.model.rate_time_s * rate
+        return sign * float(self.model.command(x, self._m))

@@ -18,13 +18,16 @@ import pandas as pd
 from seadesign.corrector.closedloop import closed_loop_table
 from seadesign.corrector.dataset import CorrectorDataset, DatasetSpec, Recording, build_dataset
 from seadesign.corrector.evaluate import open_loop_table
-from seadesign.corrector.export import export_bundle, input_list, load_meta, load_numpy, versions
+from seadesign.corrector.closedloop_training import (FINE_TUNING, MEASURED_INPUTS, RATE_TIME_S, ClosedLoopResult,
+                                                     ClosedLoopSettings, FlatPolicy, policy_arrays, train_closed_loop)
+from seadesign.corrector.export import export_bundle, input_list, load_meta, load_numpy, normalisation, versions
 from seadesign.corrector.modalities import COMBINATIONS
 from seadesign.corrector.recordings import load_recordings
 from seadesign.corrector.report import plot_curves, plot_predictions, write_table
 from seadesign.corrector.imitation import ImitationResult, ImitationSettings, train_imitation
 from seadesign.corrector.reference import ReferenceWindow
-from seadesign.corrector.runtime import Corrector, FeedForward, HallPI, NetCorrector, NoCorrection, ReferenceFeedForward
+from seadesign.corrector.runtime import (ClosedLoopCorrector, Corrector, FeedForward, HallPI, NetCorrector, NoCorrection,
+                                         ReferenceFeedForward)
 from seadesign.corrector.simcheck import SimulatorCheck, check_simulator
 from seadesign.corrector.stability import MIN_MODULUS_MARGIN, loop_gain_table
 from seadesign.corrector.splits import Split, make_split
@@ -34,6 +37,9 @@ from seadesign.design.spring import load_spring, torque_curve
 from seadesign.twin import KneeConfig, knee_effects, thesis_protocol
 
 DEFAULT_HISTORY = 3  # samples, for the history model when no --history is given
+#: models driven from the walk engine's preview (reference window), trained in the knee simulator (recordings only
+#: check it) and not scored open loop on recordings; the first is the default of `seadesign train`
+PREVIEW_MODELS = ("closedloop", "reference")
 
 
 def candidate_name(model: str, spec: DatasetSpec) -> str:
@@ -84,26 +90,36 @@ def train_bundle(spring_path: str | Path, data_paths: list[str | Path], model: s
     return out, result
 
 
+def _spring_record(spring_path: str | Path, spring: dict[str, Any]) -> dict[str, Any]:
+    return {"path": str(Path(spring_path).resolve()), "study": spring["study"], "k_source": spring["k_source"],
+            "inputs_hash": spring["inputs_hash"]}
+
+
+def _simulator_record(spring: dict[str, Any], settings: tuple[str, ...], k_scales: tuple[float, ...]) -> dict[str, Any]:
+    """The knee simulator a preview corrector was trained in: config, settings, effect chains, k scales (1)."""
+    config = KneeConfig.from_spring(spring)
+    return {"config": config.as_dict(), "settings": list(settings), "k_scales": list(k_scales),
+            "effects": {s_: knee_effects(config, s_ == "ground").describe() for s_ in settings}}
+
+
 def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
                            settings: ImitationSettings = ImitationSettings(), data_paths: list[str | Path] = (),
+                           checks: list[SimulatorCheck] | None = None,
                            ) -> tuple[Path, ImitationResult, list[SimulatorCheck]]:
     """Family 1: ILC labels in the simulator built from spring.json, the reference-window network trained on
     them, exported as a bundle whose meta records the window, k, the simulator and the control rate. The
-    recordings in `data_paths`, if any, check that simulator (`simcheck.check_simulator`; in meta)."""
+    recordings in `data_paths`, if any, check that simulator (`simcheck.check_simulator`, unless its `checks`
+    are given; in meta)."""
     spring = load_spring(spring_path)
-    checks = check_simulator(spring, list(data_paths))
+    checks = check_simulator(spring, list(data_paths)) if checks is None else checks
     result = train_imitation(spring, settings)
-    config = KneeConfig.from_spring(spring)
     meta = {
         "name": "reference-ilc", "model": "reference", "reference": settings.window.to_dict(),
         "inputs": list(settings.window.feature_names()),
         "output": "motor position command at t, rad, knee flexion (mirror the right knee in and out)",
-        "k_Nm_per_rad": float(spring["k_Nm_per_rad"]),
-        "spring": {"path": str(Path(spring_path).resolve()), "study": spring["study"], "k_source": spring["k_source"],
-                   "inputs_hash": spring["inputs_hash"]},
+        "k_Nm_per_rad": float(spring["k_Nm_per_rad"]), "spring": _spring_record(spring_path, spring),
         "control_rate_hz": settings.rate_hz,
-        "simulator": {"config": config.as_dict(), "settings": list(settings.settings),
-                      "effects": {s_: knee_effects(config, s_ == "ground").describe() for s_ in settings.settings}},
+        "simulator": _simulator_record(spring, settings.settings, settings.k_scales),
         "data": data_record(list(data_paths)), "simulator_check": [c.to_dict() for c in checks],
         "n_samples": int(sum(r.target_rad.size for r in result.labels)),
         "split": {"split": "held_out_trials", "val_every": settings.val_every},
@@ -112,6 +128,49 @@ def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
     out = export_bundle(result.training.net, meta, out_dir)
     pd.DataFrame(result.training.curve).to_csv(out / "training_curve.csv", index=False)
     return out, result, checks
+
+
+def train_closedloop_bundle(spring_path: str | Path, out_dir: str | Path, settings: ClosedLoopSettings = FINE_TUNING,
+                            family1: ImitationResult | None = None, data_paths: list[str | Path] = (),
+                            checks: list[SimulatorCheck] | None = None,
+                            ) -> tuple[Path, ClosedLoopResult, list[SimulatorCheck]]:
+    """Family 2, the default corrector: the family-1 network `family1` (trained here with `ImitationSettings()`
+    when None) fine-tuned through the closed loop in the torch knee built from spring.json, exported by
+    `export_closedloop_bundle`; meta records family 1's training under "init". The recordings in `data_paths`,
+    if any, check that simulator (`simcheck.check_simulator`, unless its `checks` are given; in meta)."""
+    spring = load_spring(spring_path)
+    checks = check_simulator(spring, list(data_paths)) if checks is None else checks
+    family1 = train_imitation(spring) if family1 is None else family1
+    result = train_closed_loop(spring, settings, family1.training.net)
+    meta = {"data": data_record(list(data_paths)), "simulator_check": [c.to_dict() for c in checks],
+            "init": {"family1": family1.summary()}}
+    return export_closedloop_bundle(result, spring_path, out_dir, meta), result, checks
+
+
+def export_closedloop_bundle(result: ClosedLoopResult, spring_path: str | Path, out_dir: str | Path,
+                             record: dict[str, Any] | None = None, name: str = "closedloop") -> Path:
+    """A family-2 bundle named `name`: flat input the reference window then `MEASURED_INPUTS`; meta records the
+    window, k, the feedback's certified bound, the simulator, control rate and training, plus `record`'s fields."""
+    spring = load_spring(spring_path)
+    policy, settings = result.policy, result.settings
+    meta = {
+        "name": name, "model": "closedloop", "reference": settings.window.to_dict(),
+        "inputs": [*settings.window.feature_names(), *MEASURED_INPUTS],
+        "measured_inputs": f"{MEASURED_INPUTS[0]} = target - hall; {MEASURED_INPUTS[1]} = {RATE_TIME_S:g} s x "
+                           "(target's finite difference / dt - hall velocity); flexion (mirror the right knee)",
+        "output": "motor position command at t, rad, knee flexion (mirror the right knee in and out)",
+        "k_Nm_per_rad": float(spring["k_Nm_per_rad"]), "spring": _spring_record(spring_path, spring),
+        "control_rate_hz": settings.rate_hz, "rate_time_s": RATE_TIME_S,
+        "feedback_lipschitz_bound_rad_per_rad": policy.feedback_lipschitz_bound(),
+        "normalisation": {**normalisation(policy.ff), "applies_to": "the reference window; the measured inputs "
+                          "enter the feedback in rad, unscaled"},
+        "simulator": _simulator_record(spring, settings.settings, settings.k_scales),
+        "split": {"split": "held_out_speeds", "val_speeds_m_per_s": list(settings.val_speeds)},
+        **(record or {}), "training": result.summary(),
+    }
+    out = export_bundle(FlatPolicy(policy), meta, out_dir, arrays=policy_arrays(policy))
+    pd.DataFrame(result.curve).to_csv(out / "training_curve.csv", index=False)
+    return out
 
 
 def find_bundles(paths: list[str | Path]) -> list[Path]:
@@ -131,9 +190,10 @@ def find_bundles(paths: list[str | Path]) -> list[Path]:
 def load_corrector(bundle: str | Path) -> tuple[Corrector, dict[str, Any]]:
     """A bundle as an online corrector (NumPy path) plus its meta."""
     meta = load_meta(bundle)
-    if meta["model"] == "reference":
-        return ReferenceFeedForward(load_numpy(bundle), ReferenceWindow(**meta["reference"]), meta["k_Nm_per_rad"],
-                                    name=meta["name"]), meta
+    if meta["model"] in PREVIEW_MODELS:
+        kind = ReferenceFeedForward if meta["model"] == "reference" else ClosedLoopCorrector
+        return kind(load_numpy(bundle), ReferenceWindow(**meta["reference"]), meta["k_Nm_per_rad"],
+                    name=meta["name"]), meta
     spec = DatasetSpec.from_dict(meta["dataset"])
     return NetCorrector(load_numpy(bundle), spec, meta["name"]), meta
 
@@ -184,14 +244,14 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
     feed_forward = (f"the torque curve of {spring_file}" if curve is not None else
                     f"k = {k:g} Nm/rad" + ("" if spring is not None else f" ({spring_file} not found)"))
     correctors: list[Corrector] = [NoCorrection(), HallPI(kp, ki), FeedForward(k, curve)] + [c for c, _ in nets]
-    measured = [(b, c, m) for b, (c, m) in zip(bundles, nets) if m["model"] != "reference"]
+    measured = [(b, c, m) for b, (c, m) in zip(bundles, nets) if m["model"] not in PREVIEW_MODELS]
     context = {"reference_bundle": str(bundles[0]), "data": data_record(data_paths),
                "k_Nm_per_rad": k, "feed_forward_spring": feed_forward, "pi": {"kp": kp, "ki": ki}, "versions": versions(),
                "candidates": {m["name"]: {"bundle": str(b), "training": m["training"], "split": m["split"]}
                               for b, (_, m) in zip(bundles, nets)},
-               "not_judged_open_loop": [m["name"] for _, m in nets if m["model"] == "reference"]}
+               "not_judged_open_loop": [m["name"] for _, m in nets if m["model"] in PREVIEW_MODELS]}
     result: dict[str, Any] = {"settings": context, "files": []}
-    if measured and data_paths:  # the reference-window family reads no measurement: nothing to score on recordings
+    if measured and data_paths:  # the preview families need the walk engine's trajectory: nothing to score on recordings
         recs = load_recordings(data_paths)
         ds, split, context["rows"] = evaluation_rows(measured[0][2], data_paths, recs)
         ol = [c for c in correctors if not getattr(c, "preview_steps", 0)]

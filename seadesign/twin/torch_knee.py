@@ -85,9 +85,11 @@ class TorchObservation:
 
 # -- effects in torch ---------------------------------------------------------------------------------------
 class _Op:
-    """One enabled effect of the chain in torch: its values and bindings are the effect's own."""
+    """One enabled effect of the chain in torch: its values and bindings are the effect's own. `per_knee`: the
+    values that may differ across the batch (`TorchKnee.vary`): those that enter only as torch factors."""
 
     stateful = False
+    per_knee: tuple[str, ...] = ()
 
     def __init__(self, effect: Effect, options: "_Options") -> None:
         self.effect, self.name, self.target = effect, effect.name, effect.target()
@@ -144,6 +146,8 @@ class _CurveSpring(_Op):
 
 
 class _Scale(_Op):
+    per_knee = ("scale",)
+
     def __call__(self, sig, state, dt):
         return self.p["scale"] * self.x(sig, "torque"), state
 
@@ -394,6 +398,21 @@ class TorchKnee:
     def tensor(self, x: Any) -> Tensor:
         """`x` as a tensor of the knee's dtype and device."""
         return torch.as_tensor(x, dtype=self.options.dtype, device=self.options.device)
+
+    def vary(self, effect: str, **values: Any) -> None:
+        """Give the enabled effect named `effect` values that differ across the batch (tensors broadcastable to
+        the batch shape (..., 2), e.g. a stiffness scale per trial of shape (n_trials, 1)) in place of the chain's
+        scalars; only values that enter as factors may vary (e.g. `stiffness_scale`'s scale)."""
+        ops = {op.name: op for ops in self.stages.values() for op in ops}
+        if effect not in ops:
+            raise ConfigError(f"no enabled effect '{effect}' in the torch knee's chain; enable it with "
+                              f"EffectChain.configure('{effect}', enabled=True) first")
+        op = ops[effect]
+        fixed = sorted(set(values) - set(op.per_knee))
+        if fixed:
+            raise ConfigError(f"effect '{effect}' cannot vary {fixed} across the batch; only "
+                              f"{list(op.per_knee) or 'none of its values'}")
+        op.p.update({name: self.tensor(v) for name, v in values.items()})
 
     # -- physics -------------------------------------------------------------------------------------------
     def _torques(self, qm: Tensor, angle: Tensor, vel: Tensor, stance: Tensor, time_s: float,
