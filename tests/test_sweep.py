@@ -205,7 +205,7 @@ def test_calibrated_sweep_reranks_and_judges_the_standing_load(tiny, tmp_path):
     s = load_study(study_path)
     base = pd.read_parquet(out / "tiny" / "results.parquet")
     b = base[base["status"] == "ok"].iloc[0]
-    limit = s.ranking.max_standing_deflection_deg
+    limit = s.requirements.max_standing_deflection_deg
     # a modulus at which the base curve, scaled, carries the standing torque at twice the limit
     curve = TorqueCurve(tuple(b["large_curve_rotation_rad"]), tuple(b["large_curve_torque_Nm"]))
     scale = s.robot.standing_knee_torque_Nm / float(curve.torque(math.radians(2 * limit)))
