@@ -16,6 +16,7 @@ import pandas as pd
 
 from seadesign.explore.encoding import Encoding
 from seadesign.sweep.rank import pareto_front
+from seadesign.sweep.requirements import total_violation
 
 SOLVED = "solved"  # evaluation column: the full pipeline gave results
 VALID = "valid"  # screening column: the geometry can be built and printed
@@ -35,11 +36,6 @@ class Problem(Protocol):
 
     def evaluate(self, X: np.ndarray) -> pd.DataFrame:
         """One row per design: SOLVED and the objective, margin and output columns (the full pipeline)."""
-
-
-def total_violation(margins: pd.DataFrame) -> pd.Series:
-    """Sum of the fractions by which requirements are missed; margins that cannot be judged add nothing."""
-    return (-margins).clip(lower=0.0).fillna(0.0).sum(axis=1)
 
 
 def judge(rows: pd.DataFrame, problem: Problem) -> pd.DataFrame:
