@@ -16,6 +16,7 @@ from seadesign.errors import MeshError, SpringFileError
 from seadesign.design.spring import TorqueCurve, load_spring, validate_spring
 from seadesign.design.study import load_study
 from seadesign.sweep.runner import run_sweep
+from helpers_browser import assert_readable
 from sweep_helpers import write_tiny_study
 
 
@@ -48,6 +49,13 @@ def test_outputs_exist_and_choice_is_the_valid_candidate(tiny):
     assert "<img" in html and "src='data:image/png;base64," in html and ".png'" not in html
     settings = json.loads((folder / "settings.json").read_text())
     assert "numpy" in settings["versions"]
+
+
+def test_sweep_report_opens_with_the_decision_in_a_browser(tiny):
+    """Headless Chromium: no error, every image loads, the decision is in the first 1366 x 768 screen."""
+    _, _, out = tiny
+    seen = assert_readable(out / "tiny" / "report.html")
+    assert "3 beams x 8 mm" in seen["decision"]["text"]
 
 
 def test_results_obey_the_physics(tiny, ccx):

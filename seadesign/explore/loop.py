@@ -24,7 +24,7 @@ import pandas as pd
 
 from threadpoolctl import threadpool_limits
 
-from seadesign.explore.doe import initial_design, initial_size, pool
+from seadesign.explore.doe import initial_design, initial_size, pool, unique_rows
 from seadesign.explore.models import Models, fit_models
 from seadesign.explore.problem import FEASIBLE, SOLVED, TOTAL_VIOLATION, VALID, Problem, best_index, front_mask, judge
 from seadesign.explore.search import far_from, propose
@@ -99,7 +99,8 @@ class _State:
         return self.settings.budget - len(self.evaluated)
 
     def screen(self, X: np.ndarray, round_index: int) -> np.ndarray:
-        """Screen the designs not screened before; returns the valid ones among X (in order)."""
+        """Screen the designs not screened before; returns the valid ones among X (in order, no repeats)."""
+        X = unique_rows(X)
         fresh = X[far_from(self.X(self.screened), X)][: max(self.screens_left, 0)]
         if len(fresh):
             rows = pd.concat([_xframe(fresh), self.problem.screen(fresh).reset_index(drop=True)], axis=1)
@@ -109,6 +110,7 @@ class _State:
         return X[~far_from(self.X(valid), X)]
 
     def evaluate(self, X: np.ndarray, round_index: int) -> int:
+        X = unique_rows(X)
         X = X[far_from(self.X(self.evaluated), X)][: self.evaluations_left]
         if not len(X):
             return 0
@@ -159,6 +161,7 @@ def explore(problem: Problem, settings: LoopSettings) -> Exploration:
     n0 = settings.initial or initial_size(enc.dim, settings.budget)
     X0 = state.screen(initial_design(enc, n0, settings.seed), 0)
     spare = pool(enc, 8 * n0, settings.seed + 1)
+    spare = spare[far_from(state.X(state.screened), spare)]  # designs not screened yet
     while len(X0) < n0 and state.screens_left > 0 and len(spare):
         take, spare = spare[: n0 - len(X0)], spare[n0 - len(X0):]
         X0 = np.vstack([X0, state.screen(take, 0)])

@@ -90,13 +90,14 @@ def write_exploration(study: Study, problem, exploration: Exploration, decision:
         "Evaluated designs (green feasible, orange infeasible, grey invalid geometry; red the choice)": fig_parallel(
             t, screened[~screened["valid"].astype(bool)], keys, [*problem.objectives, "total_violation"],
             decision.index, folder / "parallel_coordinates.png"),
-        "Sensitivity of each output to each axis (Sobol indices on the surrogates)": fig_sobol(
-            sobol, folder / "sobol.png"),
         "The search: best feasible design and least total violation against full evaluations": fig_history(
             exploration.rounds, objective, folder / "history.png"),
-        "Surrogates: leave-one-out prediction of each solved design": fig_loo(
-            exploration.models, list(problem.outputs), folder / "surrogate_loo.png"),
     }
+    if len(sobol):  # outputs with a surrogate (at least surrogate.MIN_POINTS solved designs)
+        figures["Sensitivity of each output to each axis (Sobol indices on the surrogates)"] = fig_sobol(
+            sobol, folder / "sobol.png")
+        figures["Surrogates: leave-one-out prediction of each solved design"] = fig_loo(
+            exploration.models, list(problem.outputs), folder / "surrogate_loo.png")
     renders: dict[str, Path] = {}
     if decision.index is not None:
         row = t.loc[decision.index]
