@@ -63,8 +63,8 @@ class Page:
 
 def fmt(value, digits: int = 3) -> str:
     """A number with `digits` significant digits (no exponent for everyday magnitudes); text as it is."""
-    if isinstance(value, (bool, str)) or value is None:
-        return "" if value is None else str(value)
+    if isinstance(value, (bool, str)) or value is None or value is pd.NA:
+        return "" if value is None or value is pd.NA else str(value)
     v = float(value)
     if math.isnan(v):
         return ""
