@@ -14,7 +14,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 
 from seadesign.explore.doe import pool
 from seadesign.explore.encoding import Encoding
@@ -86,11 +85,3 @@ def decide(exploration: Exploration, encoding: Encoding, requirement_words: dict
                      for c, m in margins.items() if math.isnan(m))
     return Decision(index, bool(row["feasible"]), active, missed, unjudged, predicted, p_max)
 
-
-def requirement_table(t: pd.DataFrame, requirement_words: dict[str, str]) -> pd.Series:
-    """Per row, the requirements missed, in words with the fraction each misses by (worst first)."""
-    def one(r) -> str:
-        missed = sorted((r[c], w) for c, w in requirement_words.items() if r[c] < 0)
-        return "; ".join(f"{w} (misses by {-m:.0%})" for m, w in missed)
-
-    return t.apply(one, axis=1)

@@ -21,6 +21,7 @@ import numpy as np
 from seadesign.explore.doe import pool, unique_rows
 from seadesign.explore.encoding import Encoding
 from seadesign.explore.models import Models
+from seadesign.sweep.rank import pareto_front
 
 POPULATION = 64
 GENERATIONS = 60
@@ -87,8 +88,6 @@ def propose(encoding: Encoding, models: Models, n: int, verified_X: np.ndarray, 
             seed: int) -> np.ndarray:
     """Up to `n` new designs to verify (see the module doc); `verified_F` are the solved feasible designs'
     objectives (rows of NaN for the others)."""
-    from seadesign.sweep.rank import pareto_front
-
     X, F, margins, ok = surrogate_optimum(encoding, models, seed)
     new = far_from(verified_X, X)
     X, F, margins, ok = X[new], F[new], margins[new], ok[new]

@@ -76,8 +76,9 @@ class SpringProblem:
         rows = iter(run_candidates(self.study, ok, self.out_dir, screen=True, settings=self.settings, cache=self.cache,
                                    executor=self.executor, jobs=self.jobs, scheduler=self.scheduler,
                                    quiet=True).rows.to_dict("records") if ok else [])
-        table = pd.DataFrame([next(rows) if c is not None else {"status": "invalid", "reason": why}
-                              for c, why in built])
+        table = pd.DataFrame([next(rows) if c is not None else
+                              {**dict(self.encoding.decode(x)), "status": "invalid", "reason": why}
+                              for x, (c, why) in zip(np.atleast_2d(X), built)])
         table[VALID] = table["status"] == "ok"
         valid = table[VALID]
         env = envelope(table[valid], self.study) if valid.any() else pd.DataFrame()

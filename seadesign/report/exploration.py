@@ -69,13 +69,14 @@ def write_exploration(study: Study, problem, exploration: Exploration, decision:
                       tolerance_mm: float = 0.01) -> dict[str, list[Path]]:
     """Write every output of an exploration; returns paths by kind."""
     folder.mkdir(parents=True, exist_ok=True)
-    t = exploration.evaluated.copy()
+    xcols = [f"x{i}" for i in range(problem.encoding.dim)]  # the search's unit-cube coordinates: not written
+    t = exploration.evaluated.drop(columns=xcols)
     t["pareto"] = t["front"]
     t["rank"] = pd.array([1 if i == decision.index else pd.NA for i in t.index], dtype="Int64")
     objective = problem.objectives[0]
     written = {"tables": write_tables(t, settings, folder)}
     front = t[t["front"]] if t["front"].any() else t.loc[[decision.index]] if decision.index is not None else t.iloc[[]]
-    screened = exploration.screened
+    screened = exploration.screened.drop(columns=xcols)
     extra = {"front.csv": front, "screened.csv": screened, "surrogate_loo.csv": loo_table(exploration, problem.outputs),
              "sobol.csv": sobol}
     for name, frame in extra.items():

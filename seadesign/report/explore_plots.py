@@ -69,7 +69,8 @@ def fig_parallel(evaluated: pd.DataFrame, invalid: pd.DataFrame, axes: list[str]
                 color="r", lw=2.5, label="choice")
     labels = []
     for c in cols:
-        rng = (f"{frame[c].dropna().unique()[0]}..." if frame[c].dtype == object else f"{lo[c]:.3g}-{hi[c]:.3g}")
+        rng = ("/".join(map(str, pd.Categorical(frame[c]).categories)) if frame[c].dtype == object
+               else f"{lo[c]:.3g}-{hi[c]:.3g}")
         labels.append(f"{column_label(c)}\n{rng}")
     ax.set_xticks(range(len(cols)), labels, fontsize=7, rotation=25, ha="right")
     ax.set(yticks=[], title="Evaluated designs (each column scaled to its range)")
