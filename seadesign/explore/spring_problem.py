@@ -1,7 +1,8 @@
 """The knee spring as an explorer problem: a study's design axes, screened by the geometry stage and
 evaluated by the sweep's full pipeline.
 
-Screening is the sweep's geometry stage alone (CAD, validity, volume, mass: seconds), so invalid
+Screening is the sweep's geometry stage alone (CAD, validity, volume, mass: seconds, run in this process:
+a round screens a couple of designs, less work than starting worker processes), so invalid
 designs are learned by the classifier without a mesh or a solve, and the mass and envelope margins,
 which screening gives exactly, are learned from every buildable design screened. Evaluation is the
 sweep's per-candidate pipeline (`sweep.runner.run_candidates`: geometry, mesh, linear FEA, the
@@ -74,8 +75,7 @@ class SpringProblem:
         built = self.candidates(X)
         ok = [c for c, _ in built if c is not None]
         rows = iter(run_candidates(self.study, ok, self.out_dir, screen=True, settings=self.settings, cache=self.cache,
-                                   executor=self.executor, jobs=self.jobs, scheduler=self.scheduler,
-                                   quiet=True).rows.to_dict("records") if ok else [])
+                                   executor="serial", quiet=True).rows.to_dict("records") if ok else [])
         table = pd.DataFrame([next(rows) if c is not None else
                               {**dict(self.encoding.decode(x)), "status": "invalid", "reason": why}
                               for x, (c, why) in zip(np.atleast_2d(X), built)])
