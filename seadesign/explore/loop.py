@@ -9,7 +9,9 @@ spent or the front stops moving.
 3. Stop rule: the budget of full evaluations is spent; or `patience` rounds in a row have not moved
    the front: no newly verified design entered the verified front (a feasible design that no
    earlier feasible design dominates), or, while no design is feasible, none lowered the least total
-   violation by 1 % of it or more; or the search has nothing new to propose.
+   violation by 1 % of it or more; or the search proposes nothing that was not screened before; or the
+   screening budget (`screen_factor` x the budget) is spent. A round whose proposals all screen invalid
+   teaches the classifier and does not count as a round of the front.
 Everything is seeded: the same problem, budget and seed give the same designs, so an interrupted
 run resumes by running again (evaluations come back from the problem's own store).
 """
@@ -176,13 +178,18 @@ def explore(problem: Problem, settings: LoopSettings) -> Exploration:
         want = min(settings.batch, state.evaluations_left)
         with threadpool_limits(SURROGATE_THREADS):
             models = fit_models(problem, state.evaluated, state.screened, settings.seed)
-            X = propose(enc, models, want, state.X(state.evaluated), verified_F, settings.seed + index)
-        X = state.screen(X, index)[:want]
-        before = state.evaluated.copy()
-        if not len(X) or state.evaluate(X, index) == 0:
-            stop = "the search proposed no new buildable design"
-            rounds.append(_summary(state, index, False))
+            X = propose(enc, models, want, state.X(state.screened), verified_F, settings.seed + index)
+        if not len(X):
+            stop = "the search proposed no design that was not screened before"
             break
+        before = state.evaluated.copy()
+        valid = state.screen(X, index)[:want]
+        if not len(valid):  # every proposal was invalid: the classifier learns from them; not a round of the front
+            if state.screens_left <= 0:
+                stop = "the screening budget is spent"
+                break
+            continue
+        state.evaluate(valid, index)
         moved = _moved(before, state.evaluated, problem.objectives)
         rounds.append(_summary(state, index, moved))
         still = 0 if moved else still + 1

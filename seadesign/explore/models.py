@@ -4,6 +4,7 @@ output, and the feasibility classifier; predictions of the requirement margins a
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 import pandas as pd
@@ -21,11 +22,21 @@ class Models:
     classifier: FeasibilityClassifier
     objectives: tuple[str, ...]
     margins: tuple[str, ...]
+    unjudged: Callable[[str, np.ndarray], np.ndarray] | None = None  # (column, X) -> where it cannot be judged
 
     def predict(self, columns, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(n, len(columns)) means and standard deviations."""
-        pairs = [self.surrogates[c].predict(X, return_std=True) for c in columns]
-        return np.column_stack([m for m, _ in pairs]), np.column_stack([s for _, s in pairs])
+        """(n, len(columns)) means and standard deviations; NaN (std inf) where the problem says a margin
+        cannot be judged (e.g. the strain of a material without an allowable strain)."""
+        X = np.atleast_2d(X)
+        means, sds = [], []
+        for c in columns:
+            mean, sd = self.surrogates[c].predict(X, return_std=True)
+            if self.unjudged is not None and c in self.margins:
+                skip = self.unjudged(c, X)
+                mean, sd = np.where(skip, np.nan, mean), np.where(skip, np.inf, sd)
+            means.append(mean)
+            sds.append(sd)
+        return np.column_stack(means), np.column_stack(sds)
 
     def p_feasible(self, X: np.ndarray) -> np.ndarray:
         """P(every requirement met and the design buildable), the margins' errors taken as independent."""
@@ -51,4 +62,4 @@ def fit_models(problem: Problem, evaluated: pd.DataFrame, screened: pd.DataFrame
         surrogates[column] = Surrogate(log=positive, seed=seed + j).fit(data[xcols].to_numpy(float),
                                                                          data[column].to_numpy(float))
     classifier = FeasibilityClassifier(seed).fit(screened[xcols].to_numpy(float), screened[VALID].to_numpy(bool))
-    return Models(surrogates, classifier, problem.objectives, problem.margins)
+    return Models(surrogates, classifier, problem.objectives, problem.margins, getattr(problem, "unjudged", None))

@@ -37,6 +37,8 @@ class Problem(Protocol):
     def evaluate(self, X: np.ndarray) -> pd.DataFrame:
         """One row per design: SOLVED and the objective, margin and output columns (the full pipeline)."""
 
+    # optional: unjudged(column, X) -> bool mask of the designs where a margin cannot be judged
+
 
 def judge(rows: pd.DataFrame, problem: Problem) -> pd.DataFrame:
     """Rows with TOTAL_VIOLATION (inf where not solved) and FEASIBLE (solved, no requirement missed)."""

@@ -11,7 +11,7 @@ final population the designs to verify are, in order:
    violation, spread in the design space, and, as the last pick of a batch of two or more, the design
    most likely to be feasible over a space-filling sample (the margins' uncertainty included), so the
    search also looks where the surrogates are unsure.
-Designs already verified are never proposed again.
+Designs already screened (verified, or found invalid) are never proposed again.
 """
 
 from __future__ import annotations
@@ -84,12 +84,12 @@ def surrogate_optimum(encoding: Encoding, models: Models, seed: int):
     return X, F, margins, ok
 
 
-def propose(encoding: Encoding, models: Models, n: int, verified_X: np.ndarray, verified_F: np.ndarray,
+def propose(encoding: Encoding, models: Models, n: int, screened_X: np.ndarray, verified_F: np.ndarray,
             seed: int) -> np.ndarray:
-    """Up to `n` new designs to verify (see the module doc); `verified_F` are the solved feasible designs'
-    objectives (rows of NaN for the others)."""
+    """Up to `n` designs to verify (see the module doc), none of `screened_X` (every design screened so far);
+    `verified_F` are the solved designs' objectives (rows of NaN where not feasible)."""
     X, F, margins, ok = surrogate_optimum(encoding, models, seed)
-    new = far_from(verified_X, X)
+    new = far_from(screened_X, X)
     X, F, margins, ok = X[new], F[new], margins[new], ok[new]
     picks: list[np.ndarray] = []
     if ok.any():
@@ -108,10 +108,10 @@ def propose(encoding: Encoding, models: Models, n: int, verified_X: np.ndarray, 
         order = np.argsort(violation, kind="stable")
         best = order[: max(4 * n, 1)]
         n_exploit = n - 1 if n >= 2 else n
-        picks += [X[best[i]] for i in _spread(X[best], verified_X[:0], n_exploit)]
+        picks += [X[best[i]] for i in _spread(X[best], screened_X[:0], n_exploit)]
         if n >= 2:
             sample = pool(encoding, EXPLORE_SAMPLE, seed)
-            sample = sample[far_from(np.vstack([verified_X, *picks]) if picks else verified_X, sample)]
+            sample = sample[far_from(np.vstack([screened_X, *picks]) if picks else screened_X, sample)]
             if len(sample):
                 picks.append(sample[int(np.argmax(models.p_feasible(sample)))])
     return unique_rows(np.array(picks)) if picks else np.empty((0, encoding.dim))

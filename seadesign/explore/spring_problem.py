@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from seadesign.design.space import MATERIAL_KEY
 from seadesign.design.study import Study
 from seadesign.errors import ConfigError
 from seadesign.explore.encoding import Encoding
@@ -60,6 +61,19 @@ class SpringProblem:
         self.margins = tuple(r.column for r in requirement_list(self.study))
         self.outputs = OUTPUTS
         self.screened = ("mass_g", *(m for m in ENVELOPE_MARGINS if m in self.margins))
+
+    def unjudged(self, column: str, X: np.ndarray) -> np.ndarray:
+        """Where a strain margin cannot be judged: designs of a material without a sourced allowable strain."""
+        none = np.zeros(len(X), bool)
+        if not column.endswith("_strain_margin"):
+            return none
+        keys = self.encoding.keys
+        if MATERIAL_KEY not in keys:
+            return none | (self.study.material.elongation_at_yield is None)
+        axis = self.encoding.axes[keys.index(MATERIAL_KEY)]
+        lacking = np.array([self.study.materials[n].elongation_at_yield is None for n in axis.values])
+        level = self.encoding.snap(X)[:, keys.index(MATERIAL_KEY)] * max(len(axis.values) - 1, 1)
+        return lacking[np.rint(level).astype(int)]
 
     def candidates(self, X: np.ndarray):
         """The study's candidates at unit-cube designs X (None where the study refuses the geometry, with why)."""

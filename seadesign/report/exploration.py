@@ -37,6 +37,9 @@ def headline(t: pd.DataFrame, d: Decision, objective_words: str, objective: str)
     if d.index is None:
         return "No design could be solved, so none can be chosen."
     r = t.loc[d.index]
+    if d.feasible and d.not_judged:
+        return (f"{r['candidate']} is the lightest solved design that meets every requirement that can be judged "
+                f"({objective_words} {fmt(r[objective])}), but not all can: {'; '.join(d.not_judged)}.")
     if d.feasible:
         return (f"Print {r['candidate']}: the lightest solved design that meets every requirement "
                 f"({objective_words} {fmt(r[objective])}).")
