@@ -8,9 +8,10 @@ final population the designs to verify are, in order:
    front's range) from every design already verified or picked, so the verified front fills in where
    it has gaps;
 3. while the surrogates predict nothing feasible: the designs with the smallest predicted total
-   violation, spread in the design space, and, as the last pick of a batch of two or more, the design
-   most likely to be feasible over a space-filling sample (the margins' uncertainty included), so the
-   search also looks where the surrogates are unsure.
+   violation, spread in the design space, one fewer than the batch;
+4. the rest of the batch (at least one pick of a batch of two or more while nothing is predicted
+   feasible): the designs most likely to be feasible over a space-filling sample, the margins'
+   uncertainty included, so the search also looks where the surrogates are unsure.
 Designs already screened (verified, or found invalid) are never proposed again.
 """
 
@@ -105,13 +106,11 @@ def propose(encoding: Encoding, models: Models, n: int, screened_X: np.ndarray, 
         picks += [Xf[rest[i]] for i in _spread((Ff[rest] - lo) / span, anchors, n - 1)]
     else:
         violation = np.clip(-np.nan_to_num(margins, nan=0.0), 0, None).sum(axis=1)
-        order = np.argsort(violation, kind="stable")
-        best = order[: max(4 * n, 1)]
-        n_exploit = n - 1 if n >= 2 else n
-        picks += [X[best[i]] for i in _spread(X[best], screened_X[:0], n_exploit)]
-        if n >= 2:
-            sample = pool(encoding, EXPLORE_SAMPLE, seed)
-            sample = sample[far_from(np.vstack([screened_X, *picks]) if picks else screened_X, sample)]
-            if len(sample):
-                picks.append(sample[int(np.argmax(models.p_feasible(sample)))])
+        best = np.argsort(violation, kind="stable")[: max(4 * n, 1)]
+        picks += [X[best[i]] for i in _spread(X[best], screened_X[:0], n - 1 if n >= 2 else n)]
+    if len(picks) < n:  # the rest of the batch: the designs most likely to be feasible, not screened yet
+        sample = pool(encoding, EXPLORE_SAMPLE, seed)
+        sample = sample[far_from(np.vstack([screened_X, *picks]) if picks else screened_X, sample)]
+        if len(sample):
+            picks += list(sample[np.argsort(-models.p_feasible(sample), kind="stable")[: n - len(picks)]])
     return unique_rows(np.array(picks)) if picks else np.empty((0, encoding.dim))
