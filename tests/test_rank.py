@@ -106,18 +106,24 @@ def test_weights_move_the_choice(study):
 
 def test_a_pool_that_stops_before_stall_is_ordered_by_the_usable_torque(study):
     """Usable: the smaller of the stop torque and where the strain passes the allowable. S stops at 9 Nm but
-    passes the allowable at 0.433 / 3 rad x 30 Nm/rad = 4.33 Nm."""
+    passes the allowable at 0.433 / 3 rad x 30 Nm/rad = 4.33 Nm, below both loads: it misses the strain at
+    stall and impact too, so it fails four requirements and the others two."""
     rows = [("P", 20.0, 0.2, 5.0), ("Q", 30.0, 0.2, 8.0), ("R", 25.0, 0.2, 7.0), ("S", 30.0, 3.0, 9.0)]
     t, c = rank(_table(study, rows), study)
     by = t.set_index("candidate")
     assert by.loc["S", "usable_torque_Nm"] == pytest.approx(4.33) and by.loc["Q", "usable_torque_Nm"] == 8.0
+    assert by.loc["S", "failed_constraints"] == ("carries the stall torque (11.7 Nm); carries the impact torque "
+                                                 "(27.7 Nm); stall strain < 0.433; impact strain < 0.433")
+    # the margins: travel 9 / 11.7 - 1, strain 4.33 / 11.7 - 1 at stall (and / 27.7 at impact)
+    assert by.loc["S", "stall_travel_margin"] == pytest.approx(9 / 11.7 - 1)
+    assert by.loc["S", "stall_strain_margin"] == pytest.approx(4.33 / 11.7 - 1, rel=1e-3)
     assert not c.feasible and t.loc[c.index, "candidate"] == "Q"
-    assert by.loc[["Q", "R", "P", "S"], "rank"].tolist() == [1, 2, 3, 4]
+    assert by.loc[["Q", "R", "P"], "rank"].tolist() == [1, 2, 3] and pd.isna(by.loc["S", "rank"])
     assert t["score"].isna().all() and "most usable torque" in c.explanation and "8 Nm usable" in c.explanation
 
 
 def test_k_range_and_no_feasible_candidate(study):
-    narrow = dataclasses.replace(study, ranking=dataclasses.replace(study.ranking, k_min_Nm_per_rad=100.0))
+    narrow = dataclasses.replace(study, requirements=dataclasses.replace(study.requirements, k_min_Nm_per_rad=100.0))
     t, c = rank(_table(study, ROWS), narrow)
     assert not t["feasible"].any() and not c.feasible
     assert "No candidate meets every hard constraint" in c.explanation

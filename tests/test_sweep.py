@@ -16,6 +16,7 @@ from seadesign.errors import MeshError, SpringFileError
 from seadesign.design.spring import TorqueCurve, load_spring, validate_spring
 from seadesign.design.study import load_study
 from seadesign.sweep.runner import run_sweep
+from helpers_browser import assert_readable
 from sweep_helpers import write_tiny_study
 
 
@@ -48,6 +49,13 @@ def test_outputs_exist_and_choice_is_the_valid_candidate(tiny):
     assert "<img" in html and "src='data:image/png;base64," in html and ".png'" not in html
     settings = json.loads((folder / "settings.json").read_text())
     assert "numpy" in settings["versions"]
+
+
+def test_sweep_report_opens_with_the_decision_in_a_browser(tiny):
+    """Headless Chromium: no error, every image loads, the decision is in the first 1366 x 768 screen."""
+    _, _, out = tiny
+    seen = assert_readable(out / "tiny" / "report.html")
+    assert "3 beams x 8 mm" in seen["decision"]["text"]
 
 
 def test_results_obey_the_physics(tiny, ccx):
@@ -205,7 +213,7 @@ def test_calibrated_sweep_reranks_and_judges_the_standing_load(tiny, tmp_path):
     s = load_study(study_path)
     base = pd.read_parquet(out / "tiny" / "results.parquet")
     b = base[base["status"] == "ok"].iloc[0]
-    limit = s.ranking.max_standing_deflection_deg
+    limit = s.requirements.max_standing_deflection_deg
     # a modulus at which the base curve, scaled, carries the standing torque at twice the limit
     curve = TorqueCurve(tuple(b["large_curve_rotation_rad"]), tuple(b["large_curve_torque_Nm"]))
     scale = s.robot.standing_knee_torque_Nm / float(curve.torque(math.radians(2 * limit)))

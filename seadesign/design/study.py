@@ -21,6 +21,7 @@ from seadesign.constants import G_M_PER_S2
 from seadesign.design.candidate import Candidate, check_candidate
 from seadesign.design.materials import Material, load_material
 from seadesign.design.params import ValidityRules, read_geometry
+from seadesign.design.requirements import Requirements, read_requirements
 from seadesign.design.space import MATERIAL_KEY, Axis, Value, grid, merged, read_axes
 from seadesign.design.tomlcheck import Table, find_toml, read_toml
 from seadesign.errors import ConfigError
@@ -98,12 +99,9 @@ class MeshSettings:
 
 @dataclass(frozen=True)
 class Ranking:
-    """Constraints and objective weights for choosing a candidate."""
+    """How a sweep scores candidates (the constraints are `Requirements`)."""
 
-    safety_factor: float  # peak stress must stay below yield / safety_factor
-    max_standing_deflection_deg: float  # knee deflection under the standing load
-    k_min_Nm_per_rad: float | None
-    k_max_Nm_per_rad: float | None
+    safety_factor: float  # the allowable strain is the elongation at yield / safety_factor
     impact_speed_m_per_s: float  # foot speed at touchdown
     knee_inertia_kg_m2: float  # inertia of the link behind the spring, about the knee
     weight_accuracy: float
@@ -126,6 +124,7 @@ class Study:
     mesh: MeshSettings
     ranking: Ranking
     bearing_radius_mm: float  # where the stall displacement is read (thesis eq. 5.3)
+    requirements: Requirements
 
     @property
     def material(self) -> Material:
@@ -257,26 +256,25 @@ def _mesh(top: Table) -> MeshSettings:
     return mesh
 
 
-def _ranking(top: Table) -> Ranking:
+def _ranking(top: Table) -> tuple[Ranking, Requirements]:
+    """[ranking] and the requirements it holds with [requirements] (see design/requirements.py)."""
     rk = top.table("ranking")
     if rk.raw("small_deflection_limit_rad") is not None:
         raise rk.error(rk.key("small_deflection_limit_rad"), "is no longer used: the large-deflection path replaced the "
                        "small-deflection flag; remove the line")
     ranking = Ranking(
         safety_factor=rk.number("safety_factor", ge=1),
-        max_standing_deflection_deg=rk.number("max_standing_deflection_deg", gt=0),
-        k_min_Nm_per_rad=rk.number("k_min_Nm_per_rad", gt=0, required=False),
-        k_max_Nm_per_rad=rk.number("k_max_Nm_per_rad", gt=0, required=False),
         impact_speed_m_per_s=rk.number("impact_speed_m_per_s", gt=0),
         knee_inertia_kg_m2=rk.number("knee_inertia_kg_m2", gt=0),
         weight_accuracy=rk.number("weight_accuracy", ge=0),
         weight_protection=rk.number("weight_protection", ge=0),
         contact_is_end_stop=rk.boolean("contact_is_end_stop", False),
     )
+    requirements = read_requirements(rk, top.table("requirements", optional=True))
     rk.done()
     if ranking.weight_accuracy + ranking.weight_protection <= 0:
         raise ConfigError(f"{top.file}: ranking.weight_accuracy + ranking.weight_protection must be > 0")
-    return ranking
+    return ranking, requirements
 
 
 def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
@@ -291,8 +289,9 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
         raise top.error("geometry", "is missing or not a table; add [geometry] with the fixed dimensions (mm, deg)")
     axes = read_axes(top.table("design_space"), fixed)
     robot = _robot(top)
+    ranking, requirements = _ranking(top)
     study = Study(name, description, path, _materials(top, axes), axes, fixed, _validity(top),
-                  _load_cases(top, robot), robot, _actuator(top), _mesh(top), _ranking(top), bearing_radius_mm)
+                  _load_cases(top, robot), robot, _actuator(top), _mesh(top), ranking, bearing_radius_mm, requirements)
     top.done()
     if all(not a.continuous for a in axes):
         study.candidates()  # every combination is checked now, so a bad value is named before any work starts

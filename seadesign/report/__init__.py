@@ -16,6 +16,7 @@ from seadesign.run.fingerprint import code_fingerprint
 from seadesign.design.spring import write_spring
 from seadesign.sweep.rank import Choice
 from seadesign.report.document import write_html, write_markdown
+from seadesign.report.sweep_page import sweep_page
 from seadesign.sweep.handoff import spring_document
 from seadesign.sweep.path_stage import path_key
 from seadesign.sweep.stages import SolverSettings, geometry_key
@@ -121,20 +122,26 @@ def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, s
     """Write every output of a ranked sweep; returns paths by kind."""
     folder.mkdir(parents=True, exist_ok=True)
     written: dict[str, list[Path]] = {"tables": write_tables(t, settings, folder)}
-    images = write_plots(study, t, choice, folder)
+    figures = write_plots(study, t, choice, folder)
+    renders: dict[str, Path] = {}
     cad_rows = t[t["status"] != "invalid"] if export_all else t.iloc[[]]
     if choice.index is not None:
         row = t.loc[choice.index]
-        images.update(write_renders(study, row, folder, solver, cache))
+        renders = write_renders(study, row, folder, solver, cache)
         if not export_all:
             cad_rows = t.loc[[choice.index]]
         selection = {"feasible": choice.feasible, "failed_constraints": str(row["failed_constraints"]),
                      "score": float(row["score"]), "rank": int(row["rank"]), "explanation": choice.explanation}
-        inputs_hash = digest("spring", list(t["row_key"]), study.ranking, study.robot, study.actuator)
-        written["spring"] = [write_spring(spring_document(study, row, inputs_hash, settings["versions"], selection),
-                                          folder / "spring.json")]
+        written["spring"] = [write_handoff(study, t, row, folder, settings, selection)]
     written["cad"] = export_cad(study, cad_rows, folder, tolerance_mm)
-    written["images"] = list(images.values())
-    written["report"] = [write_markdown(folder / "report.md", study, t, choice.explanation, settings, images),
-                         write_html(folder / "report.html", study, t, choice.explanation, settings, images)]
+    written["images"] = [*figures.values(), *renders.values()]
+    page = sweep_page(study, t, choice, settings, figures, renders)
+    written["report"] = [write_markdown(folder / "report.md", page), write_html(folder / "report.html", page)]
     return written
+
+
+def write_handoff(study: Study, t: pd.DataFrame, row: pd.Series, folder: Path, settings: dict,
+                  selection: dict) -> Path:
+    """spring.json of the chosen row, hashed over every evaluated row and the study's robot data."""
+    inputs_hash = digest("spring", list(t["row_key"]), study.ranking, study.requirements, study.robot, study.actuator)
+    return write_spring(spring_document(study, row, inputs_hash, settings["versions"], selection), folder / "spring.json")

@@ -39,6 +39,11 @@ class ProgressDisplay:
         running = ", ".join(f"{self.labels[i]}: {s}" for i, s in sorted(self.running.items()))
         return f"[{self.done}/{self.total} done, {time.perf_counter() - self.t0:.0f} s, {eta_text}] {running}"
 
+    def add_reused(self, n: int) -> None:
+        """`n` more tasks done from stored results (not counted in the ETA's time per task)."""
+        self.done += n
+        self.start_done += n
+
     def stage(self, index: int, stage: str) -> None:
         self.running[index] = stage
         if not self.quiet and self.tty:

@@ -33,10 +33,8 @@ import pandas as pd
 from seadesign.constants import THESIS_FEA_RESULTS
 from seadesign.design.spring import TorqueCurve
 from seadesign.design.study import Study
-
-ACCURACY = "large_stall_bearing_displacement_mm"
-PROTECTION = "impact_gearbox_torque_Nm"
-USABLE = "usable_torque_Nm"  # the order of a pool that no objective can rank: the most usable torque first
+# USABLE orders a pool that no objective can rank: the most usable torque first
+from seadesign.sweep.requirements import ACCURACY, PROTECTION, USABLE, margins, requirement_list, total_violation
 
 
 @dataclass(frozen=True)
@@ -93,35 +91,15 @@ def _thesis_result(study: Study, row: pd.Series) -> tuple[float, float]:
 
 
 def constraint_columns(t: pd.DataFrame, study: Study) -> pd.DataFrame:
-    """One boolean column per hard constraint, `feasible`, and `failed_constraints` in words."""
-    rk, lc = study.ranking, study.load_cases
-    solved = t["status"] == "ok"
-
-    def col(name: str) -> pd.Series:
-        return t[name] if name in t else pd.Series(np.nan, index=t.index)
-
-    allowable = col("large_allowable_strain")
-    known = allowable[solved & allowable.notna()]
-    limit = f"{known.iloc[0]:.3g}" if known.nunique() == 1 else "the allowable"
-    checks = {
-        "valid geometry": t["status"] != "invalid",
-        "solved": t["status"] != "failed",
-    }
-    for case, torque in (("stall", lc.stall_torque_Nm), ("impact", lc.impact_torque_Nm)):
-        carried = solved & col(f"large_{case}_rotation_rad").notna()
-        strain = col(f"large_{case}_peak_strain")
-        checks[f"carries the {case} torque ({torque:.3g} Nm)"] = carried
-        # judged only where the load is carried (a load not carried fails once); no allowable: nothing to judge
-        checks[f"{case} strain < {limit}"] = ~carried | allowable.isna() | (strain <= allowable)
-    checks[f"standing deflection < {rk.max_standing_deflection_deg:g} deg"] = \
-        solved & (t["standing_deflection_deg"] < rk.max_standing_deflection_deg)
-    if rk.k_min_Nm_per_rad is not None:
-        checks[f"k >= {rk.k_min_Nm_per_rad:g} Nm/rad"] = solved & (t["k_Nm_per_rad"] >= rk.k_min_Nm_per_rad)
-    if rk.k_max_Nm_per_rad is not None:
-        checks[f"k <= {rk.k_max_Nm_per_rad:g} Nm/rad"] = solved & (t["k_Nm_per_rad"] <= rk.k_max_Nm_per_rad)
-    t = t.copy()
-    gate = {"valid geometry": pd.Series(True, index=t.index), "solved": t["status"] != "invalid"}
-    fails = pd.DataFrame({name: gate.get(name, solved) & ~ok.fillna(False).astype(bool) for name, ok in checks.items()})
+    """The requirement margins (`sweep/requirements.py`), `total_violation`, `failed_constraints` in words,
+    their count and `feasible`. An invalid design fails only "valid geometry", one that failed to solve only
+    "solved"; a requirement that cannot be judged is not counted as failed."""
+    m = margins(t, study)
+    fails = pd.DataFrame({"valid geometry": t["status"] == "invalid", "solved": t["status"] == "failed"})
+    for r in requirement_list(study):
+        fails[r.words] = m[r.column] < 0
+    t = pd.concat([t.drop(columns=[c for c in m.columns if c in t]), m], axis=1)
+    t["total_violation"] = total_violation(m).where(t["status"] == "ok", np.inf)
     t["failed_constraints"] = ["; ".join(c for c in fails.columns if row[c]) for _, row in fails.iterrows()]
     t["n_failed_constraints"] = fails.sum(axis=1).astype(int)
     t["feasible"] = t["n_failed_constraints"] == 0
@@ -218,7 +196,7 @@ def explain(t: pd.DataFrame, best: int, second: int | None, feasible: bool) -> s
 def standing_verdict(ranked: pd.DataFrame, candidate: str, study: Study) -> str:
     """Whether `candidate` carries the robot's standing load in `ranked` (deflection vs the limit, deg)."""
     row = ranked.loc[ranked["candidate"] == candidate].iloc[0]
-    limit = study.ranking.max_standing_deflection_deg
+    limit = study.requirements.max_standing_deflection_deg
     deg = float(row["standing_deflection_deg"])
     verdict = "carries" if deg < limit else "does NOT carry"
     return (f"{candidate}: k {row['k_Nm_per_rad']:.4g} Nm/rad, standing deflection {deg:.3g} deg under "

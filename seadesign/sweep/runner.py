@@ -44,6 +44,7 @@ class Job:
     settings: SolverSettings
     cache: Cache
     row_key: str
+    screen: bool = False  # only the geometry stage (validity, volume, mass): the explorer's cheap screening
 
 
 class SweepStopped(Interrupted):
@@ -73,8 +74,15 @@ def row_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str
                   study.load_cases, study.bearing_radius_mm, candidate.material, code_fingerprint(__name__))
 
 
+def screen_key(study: Study, candidate: Candidate) -> str:
+    """Hash of every input of one candidate's screening row (its axis values, geometry verdict, material)."""
+    return digest("screen", candidate.values, geometry_key(study, candidate), candidate.material,
+                  code_fingerprint(__name__))
+
+
 def evaluate(job: Job, sink) -> dict:
-    """One candidate's row. Never raises for a candidate's own failure: the error is the row."""
+    """One candidate's row (only its geometry when screening). Never raises for a candidate's own failure:
+    the error is the row."""
     row = candidate_columns(job.candidate, job.row_key)
     t0 = time.perf_counter()
 
@@ -87,7 +95,7 @@ def evaluate(job: Job, sink) -> dict:
         row.update(geometry_columns(checked))
         if not checked.valid:
             row.update(status="invalid", reason="; ".join(checked.reasons))
-        else:
+        elif not job.screen:
             part_of = part_source(job.study, checked, part, stage)
             unit = fea_response(job.study, checked, part_of, job.settings, job.cache, stage)
             row.update(fea_columns(unit, job.study))
@@ -116,24 +124,37 @@ def write_table_atomic(df: pd.DataFrame, path: Path) -> None:
     atomic_write(path, lambda tmp: df.to_csv(tmp, index=False))
 
 
-def run_sweep(study: Study, out_dir: Path, *, settings: SolverSettings = SolverSettings(), cache: Cache = Cache(),
-              executor: str = "local", jobs: int | None = None, scheduler: str | None = None,
-              quiet: bool = False, on_row=None) -> SweepRun:
-    """Evaluate every candidate (reusing stored rows with unchanged inputs) and return the rows in
-    study order. `on_row(row)` is called as each computed row is stored (progress hooks, tests)."""
+def run_sweep(study: Study, out_dir: Path, **options) -> SweepRun:
+    """Evaluate every candidate of the study's grid (see `run_candidates`) and return the rows in study order."""
+    return run_candidates(study, study.candidates(), out_dir, **options)
+
+
+def run_candidates(study: Study, candidates: list[Candidate], out_dir: Path, *, screen: bool = False,
+                   settings: SolverSettings = SolverSettings(), cache: Cache = Cache(), executor: str = "local",
+                   jobs: int | None = None, scheduler: str | None = None, quiet: bool = False, on_row=None,
+                   display: ProgressDisplay | None = None) -> SweepRun:
+    """Evaluate `candidates` (reusing stored rows with unchanged inputs; rows in `<out>/rows/`, screening rows,
+    geometry only, in `<out>/screen/`) and return the rows in the given order. `on_row(row)` is called as each
+    computed row is stored (progress hooks, tests); `display` is a progress display the caller keeps across
+    calls (one per call by default)."""
     t0 = time.perf_counter()
-    rows_dir = Path(out_dir) / "rows"
-    candidates = study.candidates()
-    keys = [row_key(study, c, settings) for c in candidates]
+    rows_dir = Path(out_dir) / ("screen" if screen else "rows")
+    keys = [screen_key(study, c) if screen else row_key(study, c, settings) for c in candidates]
     rows: dict[int, dict] = {}
     for i, key in enumerate(keys):
         stored = read_row(rows_dir, key)
         if stored is not None and stored["status"] != "failed":  # failures are retried
             rows[i] = stored
     reused = sorted(rows)
-    todo = [Job(i, study, candidates[i], settings, cache, keys[i]) for i in range(len(candidates)) if i not in rows]
-    display = ProgressDisplay(len(candidates), len(reused), {j.index: j.candidate.name for j in todo}, quiet)
-    partial_csv = Path(out_dir) / "results.partial.csv"
+    todo = [Job(i, study, candidates[i], settings, cache, keys[i], screen) for i in range(len(candidates))
+            if i not in rows]
+    labels = {j.index: j.candidate.name for j in todo}
+    if display is None:
+        display = ProgressDisplay(len(candidates), len(reused), labels, quiet)
+    else:
+        display.labels = labels
+        display.add_reused(len(reused))
+    partial_csv = Path(out_dir) / ("screen.partial.csv" if screen else "results.partial.csv")
     killed: list[int] = []
     stream = execute(evaluate, todo, executor, jobs or default_jobs(), scheduler, display.stage, display.tick, killed)
     try:

@@ -1,0 +1,90 @@
+"""The sweep's report page: the choice and why first, then the ranked candidates, plots, the render, and
+the full table and settings collapsed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+
+from seadesign.report.document import Page, compact_table, summary_table
+from seadesign.sweep.rank import Choice
+
+RANKED_SHOWN = 10  # candidates in the compact table
+
+
+def large_deflection_summary(t: pd.DataFrame) -> str:
+    """How the solved candidates' torque paths went, in words: where they stop and why, and the strain limit."""
+    solved = t[t["status"] == "ok"]
+    if solved.empty or "large_stop_reason" not in solved:
+        return "No candidate was solved."
+    stops = solved["large_stop_reason"].value_counts()
+    allowable = solved["large_allowable_strain"].dropna()
+    text = ("Each solved candidate's hub is rotated (hyperelastic finite-strain FEA, hub held as the servo holds it) "
+            "until the impact torque or a stop. Stops: " + ", ".join(f"{r}: {n}" for r, n in stops.items()) + ". "
+            f"{int(solved['large_stall_survives'].astype(bool).sum())} of {len(solved)} carry the stall torque within "
+            f"the allowable strain; {int(solved['large_impact_survives'].astype(bool).sum())} the impact torque. Torque "
+            f"carried before the path stops: {solved['large_stop_torque_Nm'].min():.3g}-"
+            f"{solved['large_stop_torque_Nm'].max():.3g} Nm.")
+    if not allowable.empty:
+        passed = solved["large_strain_limit_torque_Nm"].dropna()
+        text += (f" Allowable strain {allowable.iloc[0]:.3g} (elongation at yield / safety factor): passed by "
+                 f"{len(passed)} candidates" + (f", at {passed.min():.3g}-{passed.max():.3g} Nm." if len(passed) else "."))
+    return text
+
+
+def constraint_counts(t: pd.DataFrame) -> str:
+    """How many candidates each requirement removed, in words."""
+    counts: dict[str, int] = {}
+    for text in t.loc[t["n_failed_constraints"] > 0, "failed_constraints"]:
+        for c in filter(None, text.split("; ")):
+            counts[c] = counts.get(c, 0) + 1
+    return "; ".join(f"{c}: {n} candidates" for c, n in counts.items()) or "none"
+
+
+def study_text(study) -> str:
+    lc = study.load_cases
+    return (f"{study.name}: {study.description}. Material "
+            + ", ".join(f"{m.name} (E = {m.youngs_modulus_Pa / 1e6:.4g} MPa, yield {m.yield_strength_Pa / 1e6:.3g} MPa)"
+                        for m in study.materials.values()) + ". "
+            f"Stall torque {lc.stall_torque_Nm:g} Nm on the hub; impact torque {lc.impact_torque_Nm:.2f} Nm on the "
+            f"backplate side; standing knee torque {study.robot.standing_knee_torque_Nm:.2f} Nm. "
+            f"Mesh: {study.mesh.elements_across_beam:g} elements across a beam ({study.mesh.backend}).")
+
+
+def objectives_text(study) -> str:
+    rk = study.ranking
+    return ("accuracy = the arc the bearing circle turns through at the stall torque, read from the large-deflection "
+            "curve (mm); protection = peak torque a foot strike drives into the gearbox: the torque where the curve has "
+            "stored the leg's kinetic energy J w^2 / 2, with "
+            f"w = {rk.impact_speed_m_per_s:g} m/s / lower leg and J = {rk.knee_inertia_kg_m2:g} kg m^2.")
+
+
+LINEAR_NOTE = ("The linear results (k at small load, stall rotation torque / k, von Mises stresses) stay in the table for "
+               "comparison with the thesis; at these loads they are outside their range, so nothing is ranked on them "
+               "and yield stress against a linear stress is not a criterion.")
+
+
+def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: dict[str, Path],
+               renders: dict[str, Path]) -> Page:
+    if choice.index is None:
+        headline, feasible = "No candidate was solved, so none can be chosen.", False
+    else:
+        name = t.loc[choice.index, "candidate"]
+        headline = (f"Print {name}: it meets every requirement and ranks first." if choice.feasible else
+                    f"No candidate meets every requirement; the nearest is {name} "
+                    f"(misses: {t.loc[choice.index, 'failed_constraints']}).")
+        feasible = choice.feasible
+    ranked = t[t["rank"].notna()].sort_values("rank").head(RANKED_SHOWN)
+    return Page(
+        title=f"Design sweep: {study.name}",
+        headline=headline, feasible=feasible,
+        why=[choice.explanation, f"Requirements that removed candidates: {constraint_counts(t)}.",
+             large_deflection_summary(t)],
+        table=compact_table(ranked, [("rank", "rank"), ("score", "score (-)")]),
+        table_caption=f"Ranked candidates (the first {len(ranked)})",
+        figures=figures, renders=renders,
+        sections=[("Study", study_text(study)), ("Objectives", objectives_text(study)), ("Linear model", LINEAR_NOTE)],
+        details=[("All candidates (full table)", summary_table(t)),
+                 ("Settings and versions", ", ".join(f"{k}: {v}" for k, v in settings.items()))],
+    )

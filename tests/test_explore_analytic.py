@@ -1,0 +1,32 @@
+"""The explorer's loop on constrained two-objective problems whose Pareto fronts are known in closed
+form (BNH, TNK; tests/helpers_analytic.py, written apart from the explorer).
+
+Budgets and thresholds (IGD with objectives scaled by the reference front's range, seed 0):
+- BNH, 40 evaluations, IGD <= 0.035. Measured 0.026-0.030 over seeds 0-2. The bar is below what the
+  same budget gives without the surrogate loop: a space-filling sample of 40 designs reaches
+  0.041-0.063 (seeds 0-4), NSGA-II on the true functions 0.047-0.224 (population 8-20, seeds 0-2).
+- TNK, 60 evaluations, IGD <= 0.05. Measured 0.022-0.032 over seeds 0-2; a space-filling sample of 60
+  reaches 0.17-0.37 and NSGA-II on the true functions 0.145-0.65. (For scale: NSGA-II needs about
+  4000-6000 true evaluations to reach 0.005-0.008 on either.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from helpers_analytic import BNH, TNK, igd
+from seadesign.explore.loop import LoopSettings, explore
+
+
+@pytest.mark.parametrize("problem, budget, threshold", [(BNH, 40, 0.035), (TNK, 60, 0.05)], ids=["BNH", "TNK"])
+def test_explorer_finds_the_known_front_within_budget(problem, budget, threshold):
+    p = problem()
+    result = explore(p, LoopSettings(budget=budget, batch=4, seed=0, patience=100))
+    t = result.evaluated
+    assert p.evaluations == len(t) <= budget
+    front = t[t["front"]]
+    # every reported front design was evaluated and meets both constraints exactly
+    f1, f2, g1, g2 = p.functions(*p.designs(front[["x0", "x1"]].to_numpy(float)).T)
+    assert np.allclose(front["f1"], f1) and (g1 >= 0).all() and (g2 >= 0).all()
+    assert igd(front[["f1", "f2"]].to_numpy(float), problem.front()) <= threshold

@@ -1,0 +1,43 @@
+"""`seadesign explore` on a tiny study: invalid geometry is screened out (counted apart from the full-path
+evaluations), every reported design was solved, the outputs are written, a rerun reuses every stored
+evaluation, and the report opens in a browser with the decision first."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from helpers_browser import assert_readable
+from seadesign.cli import main
+from seadesign.design.spring import load_spring
+from sweep_helpers import write_tiny_study
+
+
+@pytest.mark.slow  # 49 s at a load average of 6 (one full path, the report, a rerun)
+def test_explore_command(tmp_path):
+    study = write_tiny_study(tmp_path, name="tinyx")  # 3 beams x 8 mm builds; 10 beams x 8 mm does not
+    args = ["explore", str(study), "--budget", "2", "--jobs", "1", "--quiet", "--out", str(tmp_path / "out"),
+            "--cache-dir", str(tmp_path / "cache")]
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 0, result.output
+    assert "1 full-path evaluations, 2 screenings (1 invalid)" in result.output
+    folder = tmp_path / "out" / "tinyx"
+    t = pd.read_csv(folder / "results.csv")
+    assert t["candidate"].tolist() == ["3 beams x 8 mm"] and (t["status"] == "ok").all()
+    screened = pd.read_csv(folder / "screened.csv")
+    assert screened["valid"].tolist() == [True, False] and "touch" in screened.loc[1, "reason"]
+    # 3 x 8 mm stops at contact below the stall torque: nothing is feasible, and the report says what it misses
+    assert not t["feasible"].any() and "carries the stall torque" in t.loc[0, "failed_constraints"]
+    spring = load_spring(folder / "spring.json")
+    assert spring["design"]["beam_count"] == 3 and spring["selection"]["feasible"] is False
+    for name in ("front.csv", "surrogate_loo.csv", "sobol.csv", "parallel_coordinates.png", "history.png",
+                 "torque_curves.png", "3beams_8mm.stl", "3beams_8mm.step", "report.md"):
+        assert (folder / name).is_file(), name
+    assert json.loads((folder / "settings.json").read_text())["loop"]["budget"] == 2
+    seen = assert_readable(folder / "report.html")
+    assert seen["decision"]["text"].startswith("No solved design meets every requirement. The nearest, 3 beams x 8 mm")
+    rerun = CliRunner().invoke(main, args)  # every evaluation and screening comes back from the stored rows
+    assert rerun.exit_code == 0 and pd.read_csv(folder / "results.csv").equals(t)
