@@ -7,7 +7,7 @@ Prints, per candidate, k and the peak stall von Mises stress at each refinement 
 the study's elements across the beam, elements per turn on curved surfaces and layers: 1 is the
 study's default mesh), whether the peak converges, the extrapolated k,
 the observed order, each size's estimated discretization error, and the sweep's two-level
-estimate at the default (default vs the sweep's 2x coarser mesh) next to it; with --spread N, N fresh
+estimate at the default (default vs the 1.5x coarser mesh) next to it; with --spread N, N fresh
 pytetwild meshes of the first candidate at the study's size and the spread (max - min) / mean of k.
 """
 
@@ -24,9 +24,7 @@ import numpy as np
 from seadesign.fea.convergence import richardson
 from seadesign.fea.loadcases import analyse
 from seadesign.mesh import mesh_part
-from seadesign.sweep.stages import CONVERGENCE_ORDER, SolverSettings
-
-COARSENING = SolverSettings().path_coarsening  # the sweep's error-estimate mesh
+from seadesign.sweep.stages import COARSENING, CONVERGENCE_ORDER
 from seadesign.design.study import load_study
 
 

@@ -1,9 +1,10 @@
 """Mesh convergence of the large-deflection path: the curve, the contact onset and the peak strain.
 
 Usage: python benchmarks/path_convergence.py [--study wolfgang_knee] [--candidates 8x4,3x8]
-       [--coarsenings 3,2,1.5,1] [--rotations 0.1,0.2,0.3]
-Prints, per candidate and mesh (a coarsening of the study's mesh: 1 is the result mesh, 2 the sweep's
-path mesh), the degrees of freedom, the torque at each listed rotation (Nm), where and why the path stops
+       [--meshes 2,path,1] [--rotations 0.1,0.2,0.3]
+Prints, per candidate and mesh (a number: that coarsening of the study's mesh, 1 being the result mesh;
+"path": the sweep's path mesh, the result mesh's in-plane sizing with SolverSettings.path_layers layers
+through the thickness; the finest last), the degrees of freedom, the torque at each listed rotation (Nm), where and why the path stops
 (rad, Nm), the torque where the peak strain passes the allowable strain, the peak strain at the first listed
 rotation, the time, and each number's difference to the coarsest mesh's as each mesh finishes (a
 run stopped early keeps its rows), then the table again against the finest. Contact and strain peaks sit at beam
@@ -22,7 +23,7 @@ from seadesign.design.study import load_study
 from seadesign.fea.large_deflection import large_deflection
 from seadesign.fea.rotation_path import PathSettings, rotation_path
 from seadesign.run.cache import Cache
-from seadesign.sweep.stages import check_geometry, tetrahedralize
+from seadesign.sweep.stages import SolverSettings, check_geometry, tetrahedralize
 
 
 def _number(value: float | None) -> float:
@@ -38,12 +39,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--study", default="wolfgang_knee")
     ap.add_argument("--candidates", default="8x4,3x8", help="beams x thickness_mm, comma separated")
-    ap.add_argument("--coarsenings", default="3,2,1.5,1", help="edge-length factors on the study's mesh")
+    ap.add_argument("--meshes", default="2,path,1", help="edge-length factors on the study's mesh, or path")
     ap.add_argument("--rotations", default="0.1,0.2,0.3", help="rotations (rad) where the torque is compared")
     args = ap.parse_args()
     st = load_study(args.study)
     cache = Cache()
-    coarsenings = [float(c) for c in args.coarsenings.split(",")]
+    meshes = args.meshes.split(",")
     rotations = [float(r) for r in args.rotations.split(",")]
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
     print(f"study {st.name}, material {st.material.name} ({st.material.law.model}, C10 {st.material.law.c10_Pa / 1e6:.3g} MPa, D1 {st.material.law.d1_per_Pa * 1e6:.3g} 1/MPa), path settings {PathSettings()}")
@@ -56,8 +57,9 @@ def main() -> None:
               f"torque (Nm); peak strain at {rotations[0]:g} rad; in brackets: relative difference to the first "
               f"(coarsest) mesh, then the table again against the finest", flush=True)
         rows = []
-        for c in coarsenings:
-            mesh = tetrahedralize(st, candidate, part, cache, c)
+        for c in meshes:
+            mesh = (tetrahedralize(st, candidate, part, cache, layers=SolverSettings().path_layers) if c == "path"
+                    else tetrahedralize(st, candidate, part, cache, float(c)))
             path = rotation_path(mesh, m.law, lc.impact_torque_Nm, PathSettings())
             ld = large_deflection(path, st.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
                                   m.allowable_strain(st.ranking.safety_factor))
@@ -76,7 +78,7 @@ def _print_row(row, ref) -> None:
     def rel(v, r):
         return f"{v:.4g} [{(v - r) / r:+.2%}]"
 
-    print(f"  coarsening {c:<4g} {dofs:>8d} dofs  T " + ", ".join(rel(v, r) for v, r in zip(torques, ref[2]))
+    print(f"  mesh {c:<5} {dofs:>8d} dofs  T " + ", ".join(rel(v, r) for v, r in zip(torques, ref[2]))
           + f"  stop {reason} {rel(stop_rad, ref[4])} rad {rel(stop_Nm, ref[5])} Nm  strain limit "
           f"{rel(limit_Nm, ref[6])} Nm  strain {rel(strain, ref[7])}  {secs:.0f} s", flush=True)
 

@@ -1,8 +1,8 @@
 """The large-deflection stage of a sweep: a candidate's torque path, read at its loads.
 
 The path (`fea.rotation_path`, the material's hyperelastic law) runs from rest to the study's impact
-torque or to where it stops, on a mesh `SolverSettings.path_coarsening` times coarser than the
-result mesh (its error against the result mesh is in the README's table). `fea.large_deflection`
+torque or to where it stops, on the result mesh's in-plane sizing with `SolverSettings.path_layers`
+layers through the thickness (its error against the result mesh is in the README's table). `fea.large_deflection`
 reads it at the standing, stall and impact torques. The result is cached under the mesh, the law,
 the path settings, the torques, the allowable strain, the end-stop rule and the code.
 """
@@ -45,7 +45,7 @@ def path_key(study: Study, candidate: Candidate, settings: SolverSettings) -> st
     """Inputs of the path: the mesh, the law, the path's mesh and settings, the torques, the allowable strain,
     the end-stop rule and the code of this module with everything it imports."""
     lc = study.load_cases
-    return digest("path", mesh_key(study, candidate), candidate.material.law, settings.path_coarsening,
+    return digest("path", mesh_key(study, candidate), candidate.material.law, settings.path_layers,
                   settings.path_formulation, PathSettings(), study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm,
                   lc.impact_torque_Nm, candidate.material.allowable_strain(study.ranking.safety_factor),
                   study.ranking.contact_is_end_stop, code_fingerprint(__name__), package_versions())
@@ -59,7 +59,7 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     if hit is not None:
         return hit
     progress("mesh")
-    mesh = tetrahedralize(study, candidate, part(), cache, settings.path_coarsening)
+    mesh = tetrahedralize(study, candidate, part(), cache, layers=settings.path_layers)
     progress("path")
     lc, m = study.load_cases, candidate.material
     path = rotation_path(mesh, m.law, lc.impact_torque_Nm, PathSettings(), order=settings.element_order,

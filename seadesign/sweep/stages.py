@@ -8,9 +8,9 @@ changing one input recomputes only the stages that depend on it. The FEA is solv
 columns are made from these objects in `sweep/table.py`.
 
 Meshing is `seadesign.mesh.mesh_part`, the solve `seadesign.fea.loadcases.analyse` at 1 Nm per
-load case; a second P2 solve on the large-deflection path's mesh (`SolverSettings.path_coarsening`
-times coarser, meshed once for both) gives the discretization-error estimate of k (two-level
-Richardson at CONVERGENCE_ORDER, the smallest order observed in benchmarks/fea_convergence.py).
+load case; a second P2 solve on a mesh COARSENING times coarser gives the discretization-error
+estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest order observed in
+benchmarks/fea_convergence.py).
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ if TYPE_CHECKING:
     from seadesign.fea.results import LinearResults
 
 Progress = Callable[[str], None]  # receives the name of the stage that starts
+COARSENING = 1.5  # edge-length ratio of the error-estimate mesh to the result mesh
 CONVERGENCE_ORDER = 1.1  # smallest order of k observed in benchmarks/fea_convergence.py (1.10-1.89)
 
 
@@ -41,7 +42,9 @@ class SolverSettings:
 
     element_order: int = 2  # P2 tetrahedra
     linear_solver: str = "pardiso"  # "pardiso" or "scipy"
-    path_coarsening: float = 2.0  # edge-length ratio of the large-deflection path's mesh to the result mesh
+    path_layers: int = 1  # layers through the thickness of the large-deflection path's mesh (a prismatic part's):
+    # its in-plane sizing is the result mesh's, which resolves the beam-root fillets where contact and
+    # creases start (README: a 2x coarser mesh put contact 11-26 % late)
     path_formulation: str = "full"  # volumetric formulation of the path (fea.finite_strain), as CalculiX's C3D10
 
 
@@ -51,8 +54,7 @@ class UnitResponse:
     estimate's coarse k, and how the mesh and solve went."""
 
     results: LinearResults  # both load cases at 1 Nm
-    k_coarse_Nm_per_rad: float  # k on the coarse mesh (error estimate of k)
-    coarsening: float  # edge-length ratio of the coarse mesh to the result mesh
+    k_coarse_Nm_per_rad: float  # k on a COARSENING times coarser mesh (error estimate of k)
     time_fea_total_s: float
     time_error_estimate_s: float
     mesh_mean_aspect_ratio: float
@@ -77,7 +79,7 @@ def fea_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str
     this module with everything it imports (the solver, the mesher, the study's mesh sizing)."""
     m = candidate.material
     return digest("fea", mesh_key(study, candidate), m.youngs_modulus_Pa, m.poisson_ratio,
-                  settings.element_order, settings.linear_solver, settings.path_coarsening,
+                  settings.element_order, settings.linear_solver,
                   code_fingerprint("seadesign.sweep.stages", "seadesign.mesh.worker"), package_versions())
 
 
@@ -93,14 +95,19 @@ def check_geometry(study: Study, candidate: Candidate, cache: Cache) -> tuple[Ca
     return checked, part
 
 
-def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache, coarsening: float = 1.0):
+def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache, coarsening: float = 1.0,
+                   layers: int | None = None):
     """Tetrahedral mesh (mm) of a built part with named interface boundaries (mesh package,
     its own content-addressed cache under the sweep cache's root); `coarsening` > 1 makes the
-    elements that many times longer (beam, curvature and layer sizing alike)."""
+    elements that many times longer (beam, curvature and layer sizing alike); `layers` replaces the
+    study's layers through a prismatic part's thickness."""
     from seadesign.mesh import mesh_part
 
+    options = study.mesh.scaled(1.0 / coarsening).mesh_part_options()
+    if layers is not None:
+        options["layers"] = layers
     return mesh_part(part.solid, part.interfaces, beam_width_mm=candidate.params.beam_thickness_mm,
-                     cache_dir=Path(cache.root) / "mesh", **study.mesh.scaled(1.0 / coarsening).mesh_part_options())
+                     cache_dir=Path(cache.root) / "mesh", **options)
 
 
 def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, settings: SolverSettings) -> UnitResponse:
@@ -118,7 +125,6 @@ def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, setting
     return UnitResponse(
         results=a.results,
         k_coarse_Nm_per_rad=1.0 / float(coarse.hub_motion[5]),
-        coarsening=settings.path_coarsening,
         time_fea_total_s=t1 - t0,
         time_error_estimate_s=time.perf_counter() - t1,
         mesh_mean_aspect_ratio=mesh.quality.mean_aspect_ratio,
@@ -151,7 +157,7 @@ def fea_response(study: Study, candidate: Candidate, part: Callable[[], Part], s
         return unit
     progress("mesh")
     mesh = tetrahedralize(study, candidate, part(), cache)
-    coarse_mesh = tetrahedralize(study, candidate, part(), cache, settings.path_coarsening)
+    coarse_mesh = tetrahedralize(study, candidate, part(), cache, COARSENING)
     progress("fea")
     unit = unit_response(mesh, coarse_mesh, study, candidate, settings)
     cache.put("fea", fkey, unit)

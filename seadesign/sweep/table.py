@@ -15,7 +15,7 @@ from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
 from seadesign.fea.results import columns
 from seadesign.sweep.path_stage import PathResponse
-from seadesign.sweep.stages import CONVERGENCE_ORDER, UnitResponse
+from seadesign.sweep.stages import COARSENING, CONVERGENCE_ORDER, UnitResponse
 
 
 def candidate_columns(candidate: Candidate, row_key: str) -> dict:
@@ -47,7 +47,7 @@ def fea_columns(unit: UnitResponse, study: Study) -> dict[str, float]:
         "stall_foot_error_mm": r.stall.bearing_displacement_mm / study.bearing_radius_mm * lc.lower_leg_m * 1e3,
         "k_coarse_Nm_per_rad": unit.k_coarse_Nm_per_rad,
         # two-level Richardson: error of k_h ~ |k_h - k_rh| / (r^p - 1)
-        "k_rel_error": abs(unit.k_coarse_Nm_per_rad - k) / k / (unit.coarsening**CONVERGENCE_ORDER - 1.0),
+        "k_rel_error": abs(unit.k_coarse_Nm_per_rad - k) / k / (COARSENING**CONVERGENCE_ORDER - 1.0),
         "mesh_mean_aspect_ratio": unit.mesh_mean_aspect_ratio,
         "mesh_target_edge_mm": unit.mesh_target_edge_mm,
         "mesh_tetrahedralize_s": unit.mesh_tetrahedralize_s,
