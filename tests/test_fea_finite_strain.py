@@ -70,7 +70,6 @@ def test_residual_and_tangent_equal_scikit_fem(small):
     x = emesh.nodes_m / 0.012
     u = 0.6e-3 * np.column_stack([np.sin(2 * x[:, 1]) * x[:, 2], x[:, 0] ** 2 - x[:, 2], np.cos(x[:, 0]) * x[:, 1]])
     solid = Solid.of(emesh, NEO)
-    n = len(emesh.nodes_m)
     forces = solid.forces(u).ravel()
     k = full_from_upper(solid.tangent(u).matrix()).toarray()
 
@@ -100,7 +99,6 @@ def test_forces_and_tangent_are_derivatives_of_the_energy(small, law, formulatio
     f_fd = (solid.forces(u + h * v) - solid.forces(u - h * v)) / (2 * h)
     assert solid.forces(u).ravel() @ v.ravel() == pytest.approx(e_fd, rel=1e-9)  # measured 1.4e-10, 2.1e-10
     kv = solid.tangent_product(u, v)
-    n = len(u)
     k = full_from_upper(solid.tangent(u).matrix())
     assert np.abs(kv - f_fd).max() < 5e-10 * np.abs(f_fd).max()  # measured 3.9e-11, 1.1e-10
     assert np.abs((k @ v.ravel()).reshape(-1, 3) - kv).max() < 1e-12 * np.abs(kv).max()
