@@ -5,7 +5,8 @@ Usage: python benchmarks/fea.py [--study wolfgang_knee] [--beams 8] [--thickness
        [--no-path] [--max-rotation-rad 0.4]
 Prints machine, settings, per-stage seconds and the ratio (our assembly + factorization + solve)
 / (ccx wall time, which includes its own input reading, assembly and solve). Then the
-large-deflection path (fea.rotation_path, to the stall torque or where it stops, no strain stop):
+large-deflection path on the sweep's path mesh (the same sizing with SolverSettings.path_layers layers
+through the thickness; fea.rotation_path, to the stall torque or where it stops, no strain stop):
 its time split into assembly / factorization / solve / stop checks (the solver's methods timed from
 here, the library unchanged), Newton iterations per increment, one assembly of the residual and the
 tangent at the path's last state against scikit-fem's assembly of the same law (tests/helpers_skfem.py),
@@ -37,6 +38,7 @@ from seadesign.fea.loadcases import analyse
 from seadesign.fea.pardiso import Pardiso
 from seadesign.mesh import mesh_part
 from seadesign.design.study import load_study
+from seadesign.sweep.stages import SolverSettings
 from seadesign.fea.elements import element_mesh
 from seadesign.fea.linsolve import full_from_upper
 
@@ -109,6 +111,9 @@ def main() -> None:
                          cache_dir=cache, backend=args.backend, elements_per_circle=per_circle,
                          layers=sizing.mesh_part_options()["layers"] if args.backend == "gmsh" else 0)
         t_mesh = time.perf_counter() - t
+        path_mesh = mesh_part(part.solid, part.interfaces, across, args.thickness_mm, cache_dir=cache,
+                              backend=args.backend, elements_per_circle=per_circle,
+                              layers=SolverSettings().path_layers if args.backend == "gmsh" else 0)
     stages["tessellation / BREP export"] = mesh.info["geometry_s"]
     stages["tetrahedralization (child process)"] = mesh.info["tetrahedralize_s"]
     stages["boundaries + quality"] = t_mesh - mesh.info["geometry_s"] - mesh.info["tetrahedralize_s"]
@@ -140,7 +145,7 @@ def main() -> None:
     else:
         linear_ccx(a, m, lc, r)
     if not args.no_path:
-        path_benchmark(mesh, m, lc, args.max_rotation_rad, use_ccx)
+        path_benchmark(path_mesh, m, lc, args.max_rotation_rad, use_ccx)
 
 
 def linear_ccx(a, m, lc, r: dict) -> None:
@@ -159,8 +164,10 @@ def linear_ccx(a, m, lc, r: dict) -> None:
 
 
 def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool) -> None:
-    """The large-deflection path with its time split, and CalculiX NLGEOM at the path's rotations."""
+    """The large-deflection path on the sweep's path mesh (this sizing, SolverSettings.path_layers layers through
+    the thickness) with its time split, and CalculiX NLGEOM at the path's rotations."""
     law = m.law
+    print(f"path mesh: {len(mesh.tets)} tets, {SolverSettings().path_layers} layer(s) through the thickness")
     with timed(PATH_PARTS) as parts:
         path = rp.rotation_path(mesh, law, lc.stall_torque_Nm, rp.PathSettings(max_rotation_rad=max_rotation_rad))
     points = path.points[1:]

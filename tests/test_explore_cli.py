@@ -41,3 +41,22 @@ def test_explore_command(tmp_path):
     assert seen["decision"]["text"].startswith("No solved design meets every requirement. The nearest, 3 beams x 8 mm")
     rerun = CliRunner().invoke(main, args)  # every evaluation and screening comes back from the stored rows
     assert rerun.exit_code == 0 and pd.read_csv(folder / "results.csv").equals(t)
+
+
+@pytest.mark.slow  # two explorations of one full path each
+def test_explore_on_a_dask_cluster_verifies_the_same_designs(tmp_path):
+    pytest.importorskip("distributed")
+    study = write_tiny_study(tmp_path, name="tinyx")
+    tables = {}
+    for executor in ("local", "dask"):
+        out = tmp_path / executor
+        result = CliRunner().invoke(main, ["explore", str(study), "--budget", "2", "--jobs", "2", "--batch", "1",
+                                           "--executor", executor, "--quiet", "--out", str(out),
+                                           "--cache-dir", str(tmp_path / f"cache-{executor}")])
+        assert result.exit_code == 0, result.output
+        tables[executor] = pd.read_csv(out / "tinyx" / "results.csv")
+    local, dask = tables["local"], tables["dask"]
+    assert dask["candidate"].tolist() == local["candidate"].tolist() == ["3 beams x 8 mm"]
+    # the same mesh and solves on a Dask worker: the numbers agree to round-off
+    for col in ("k_Nm_per_rad", "large_stop_rotation_rad", "large_stop_torque_Nm"):
+        assert dask.loc[0, col] == pytest.approx(local.loc[0, col], rel=1e-9), col
