@@ -130,13 +130,33 @@ def test_k_range_and_no_feasible_candidate(study):
     assert t.loc[c.index, "n_failed_constraints"] == t.loc[t["status"] == "ok", "n_failed_constraints"].min()
 
 
+def _path_row(theta: np.ndarray, torque: np.ndarray, stop_rad: float, stop_Nm: float) -> pd.Series:
+    return pd.Series({"large_curve_rotation_rad": list(theta), "large_curve_torque_Nm": list(torque),
+                      "large_stop_rotation_rad": stop_rad, "large_stop_torque_Nm": stop_Nm})
+
+
 def test_strike_torque_of_a_softening_curve():
     """T = A tanh(theta / B) stores E(theta) = A B ln cosh(theta / B): the torque at energy E is
     A tanh(acosh(exp(E / (A B))))."""
     a, b = 15.0, 0.8
     theta = np.linspace(0.0, 1.2, 25)
+    row = _path_row(theta, a * np.tanh(theta / b), theta[-1], a * math.tanh(theta[-1] / b))
     for energy in (0.01, 0.5, 3.0):
         exact = a * math.tanh(math.acosh(math.exp(energy / (a * b))))
         # PCHIP through 25 points: measured 1.9e-5 relative at most
-        assert strike_torque(theta, a * np.tanh(theta / b), energy) == pytest.approx(exact, rel=6e-5)
-    assert math.isnan(strike_torque(theta, a * np.tanh(theta / b), 20.0))  # stores at most 6.1 J
+        assert strike_torque(row, energy) == pytest.approx(exact, rel=6e-5)
+    assert math.isnan(strike_torque(row, 20.0))  # stores at most 6.1 J
+
+
+def test_strike_torque_of_a_path_that_ends_at_a_limit_point():
+    """T = A sin(theta / B) up to its maximum at pi B / 2, where the path stops; its last point lies past the
+    maximum (the path found it there), and the curve is read up to the stop. E(theta) = A B (1 - cos(theta / B)):
+    the torque at energy E is A sin(acos(1 - E / (A B)))."""
+    a, b = 6.0, 0.2
+    top = math.pi * b / 2
+    theta = np.append(np.linspace(0.0, 0.95 * top, 20), 1.1 * top)
+    row = _path_row(theta, a * np.sin(theta / b), top, a)
+    for energy in (0.05, 0.3):  # of at most A B = 1.2 J
+        exact = a * math.sin(math.acos(1 - energy / (a * b)))
+        # PCHIP through 21 points: measured 8.7e-6 and 2.1e-5 relative
+        assert strike_torque(row, energy) == pytest.approx(exact, rel=6e-5)

@@ -55,9 +55,9 @@ def spring_document(study: Study, row: pd.Series, inputs_hash: str, versions: di
     }
 
 
-def handoff_curve(row: pd.Series, contact_is_end_stop: bool) -> dict:
-    """The row's torque curve up to where its path stops (the stop point is the last point): at the impact
-    torque, a limit point's maximum, contact; a hard stop when contact is the study's end stop."""
+def curve_to_stop(row: pd.Series) -> tuple[list[float], list[float]]:
+    """The row's path points (rad, Nm) up to where it stops, the stop point last: at the impact torque, a limit
+    point's maximum (the points past it dropped: the curve increases strictly), contact."""
     theta, torque = list(row["large_curve_rotation_rad"]), list(row["large_curve_torque_Nm"])
     stop_theta, stop_torque = float(row["large_stop_rotation_rad"]), float(row["large_stop_torque_Nm"])
     keep = [i for i, t in enumerate(theta) if t < stop_theta and (i == 0 or torque[i] < stop_torque)]
@@ -65,6 +65,13 @@ def handoff_curve(row: pd.Series, contact_is_end_stop: bool) -> dict:
     if stop_theta > rotation[-1] and stop_torque > torques[-1]:
         rotation.append(stop_theta)
         torques.append(stop_torque)
+    return rotation, torques
+
+
+def handoff_curve(row: pd.Series, contact_is_end_stop: bool) -> dict:
+    """The row's torque curve up to where its path stops (`curve_to_stop`); a hard stop when contact is the
+    study's end stop."""
+    rotation, torques = curve_to_stop(row)
     reason = str(row["large_stop_reason"])
     return {"rotation_rad": rotation, "torque_Nm": torques, "source": "fea_large_deflection", "stop_reason": reason,
             "hard_stop": reason == "contact" and contact_is_end_stop,

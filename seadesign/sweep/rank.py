@@ -33,6 +33,7 @@ import pandas as pd
 from seadesign.constants import THESIS_FEA_RESULTS
 from seadesign.design.spring import TorqueCurve
 from seadesign.design.study import Study
+from seadesign.sweep.handoff import curve_to_stop
 # USABLE orders a pool that no objective can rank: the most usable torque first
 from seadesign.sweep.requirements import ACCURACY, PROTECTION, USABLE, margins, requirement_list, total_violation
 
@@ -57,9 +58,10 @@ def pareto_front(objectives: np.ndarray) -> np.ndarray:
     return mask
 
 
-def strike_torque(rotation_rad, torque_Nm, energy_J: float) -> float:
-    """The torque (Nm) where a curve through (0, 0) has stored `energy_J` (J); NaN when it stores less."""
-    torque = TorqueCurve(tuple(rotation_rad), tuple(torque_Nm)).torque_at_energy(energy_J)
+def strike_torque(row: pd.Series, energy_J: float) -> float:
+    """The torque (Nm) where the row's curve, up to where its path stops, has stored `energy_J` (J); NaN when
+    it stores less."""
+    torque = TorqueCurve(*map(tuple, curve_to_stop(row))).torque_at_energy(energy_J)
     return math.nan if torque is None else torque
 
 
@@ -76,8 +78,7 @@ def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
     t["strike_energy_J"] = energy
     if "large_stop_torque_Nm" in t:
         t[USABLE] = t[["large_stop_torque_Nm", "large_strain_limit_torque_Nm"]].min(axis=1, skipna=True)
-    t[PROTECTION] = [strike_torque(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], energy) if ok else np.nan
-                     for ok, (_, r) in zip(solved, t.iterrows())]
+    t[PROTECTION] = [strike_torque(r, energy) if ok else np.nan for ok, (_, r) in zip(solved, t.iterrows())]
     thesis = [_thesis_result(study, row) for _, row in t.iterrows()]
     t["thesis_reaction_N"] = [r for r, _ in thesis]
     t["thesis_displacement_mm"] = [d for _, d in thesis]
