@@ -259,12 +259,14 @@ def write_path_inp(
 class CcxPath:
     """CalculiX's torque-rotation path: the requested rotations (rad) whose steps converged, in order,
     and the reaction torque about z (Nm) there; `failure` is ccx's message when a step did not
-    converge (that rotation and the later ones are absent), None when all did. Increments and
-    Newton iterations count every attempt (cut-back ones too); wall time in s."""
+    converge (that rotation and the later ones are absent), None when all did; `reached_rad` is the
+    rotation of the last increment ccx converged (within a step it did not finish, where it stopped).
+    Increments and Newton iterations count every attempt (cut-back ones too); wall time in s."""
 
     rotation_rad: np.ndarray
     torque_Nm: np.ndarray
     failure: str | None
+    reached_rad: float
     increments: int
     iterations: int
     wall_s: float
@@ -298,11 +300,14 @@ def run_ccx_path(inp: Path, nodes_m: np.ndarray, rotations_rad: Sequence[float],
         if not np.array_equal(u[:, 0], f[:, 0]):
             raise SolverError("ccx printed displacements and reaction forces of different hub nodes")
         torque.append(moment_z(nodes_m[u[:, 0].astype(int) - 1] + u[:, 1:4], f[:, 1:4]))
+    increments = [line.split() for line in sta.read_text().splitlines()[2:]]
+    converged = [float(row[4]) for row in increments if not row[2].endswith("U")]  # attempts that failed read "1U"
     return CcxPath(
         rotation_rad=theta[:n],
         torque_Nm=np.array(torque),
         failure=f"{'; '.join(errors)} (step to {theta[n]:.6g} rad)" if errors else None,
-        increments=len(sta.read_text().splitlines()) - 2,
+        reached_rad=max(converged, default=0.0),
+        increments=len(increments),
         iterations=sum(1 for line in cvg.read_text().splitlines()[4:] if line.split()),
         wall_s=wall,
     )
