@@ -53,8 +53,8 @@ def test_calculix_nlgeom_agrees_on_study_candidates(tmp_path, ccx, beams, thickn
     stability at 0.257 rad on this mesh, and CalculiX cannot pass that rotation either, on any increments
     (measured: it stops at 0.25736 rad with increments of 2e-6 rad). The path finds the instability only
     with steps of at most 4 mrad: with 10 mrad steps or the default ones it steps over it to stable states
-    past it and stops at contact near 0.32 rad (measured), which is why the study checks this candidate
-    with small steps. Ours 51 / 18 s, CalculiX 68 / 151 s on 2 cores."""
+    past it and stops at contact near 0.32 rad (measured), so this check takes small steps. Ours 51 / 18 s,
+    CalculiX 68 / 151 s on 2 cores."""
     from seadesign.design.study import load_study
     from seadesign.run.cache import Cache
     from seadesign.sweep.stages import tetrahedralize
