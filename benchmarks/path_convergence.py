@@ -1,7 +1,7 @@
 """Mesh convergence of the large-deflection path: the curve, the contact onset and the peak strain.
 
 Usage: python benchmarks/path_convergence.py [--study wolfgang_knee] [--candidates 8x4,3x8]
-       [--meshes 2,path,1] [--rotations 0.1,0.2,0.3]
+       [--meshes 2,path,1] [--rotations 0.1,0.2,0.3] [--max-step-rad 0.004]
 Prints, per candidate and mesh (a number: that coarsening of the study's mesh, 1 being the result mesh;
 "path": the sweep's path mesh, the result mesh's in-plane sizing with SolverSettings.path_layers layers
 through the thickness; the finest last), the degrees of freedom, the torque at each listed rotation (Nm), where and why the path stops
@@ -41,13 +41,16 @@ def main() -> None:
     ap.add_argument("--candidates", default="8x4,3x8", help="beams x thickness_mm, comma separated")
     ap.add_argument("--meshes", default="2,path,1", help="edge-length factors on the study's mesh, or path")
     ap.add_argument("--rotations", default="0.1,0.2,0.3", help="rotations (rad) where the torque is compared")
+    ap.add_argument("--max-step-rad", type=float, default=PathSettings().max_step_rad,
+                    help="the path's largest step (rad): smaller steps check that no narrow instability is stepped over")
     args = ap.parse_args()
+    settings = PathSettings(max_step_rad=args.max_step_rad)
     st = load_study(args.study)
     cache = Cache()
     meshes = args.meshes.split(",")
     rotations = [float(r) for r in args.rotations.split(",")]
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
-    print(f"study {st.name}, material {st.material.name} ({st.material.law.model}, C10 {st.material.law.c10_Pa / 1e6:.3g} MPa, D1 {st.material.law.d1_per_Pa * 1e6:.3g} 1/MPa), path settings {PathSettings()}")
+    print(f"study {st.name}, material {st.material.name} ({st.material.law.model}, C10 {st.material.law.c10_Pa / 1e6:.3g} MPa, D1 {st.material.law.d1_per_Pa * 1e6:.3g} 1/MPa), path settings {settings}")
     for spec in args.candidates.split(","):
         n, t = spec.split("x")
         candidate, part = check_geometry(st, st.candidate(beam_count=int(n), beam_thickness_mm=float(t)), cache)
@@ -60,7 +63,7 @@ def main() -> None:
         for c in meshes:
             mesh = (tetrahedralize(st, candidate, part, cache, layers=SolverSettings().path_layers) if c == "path"
                     else tetrahedralize(st, candidate, part, cache, float(c)))
-            path = rotation_path(mesh, m.law, lc.impact_torque_Nm, PathSettings())
+            path = rotation_path(mesh, m.law, lc.impact_torque_Nm, settings)
             ld = large_deflection(path, st.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
                                   m.allowable_strain(st.ranking.safety_factor))
             rows.append((c, ld.dofs, [_number(path.torque_at(r)) for r in rotations], path.stop_reason,
