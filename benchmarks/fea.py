@@ -106,14 +106,15 @@ def main() -> None:
     if not checked.valid:
         raise SystemExit(f"candidate is invalid: {checked.reasons}")
     with tempfile.TemporaryDirectory() as cache:  # fresh: no cached mesh
+        def mesh_with(layers: int):
+            return mesh_part(part.solid, part.interfaces, across, args.thickness_mm, cache_dir=cache,
+                             backend=args.backend, elements_per_circle=per_circle,
+                             layers=layers if args.backend == "gmsh" else 0)
+
         t = time.perf_counter()
-        mesh = mesh_part(part.solid, part.interfaces, across, args.thickness_mm,
-                         cache_dir=cache, backend=args.backend, elements_per_circle=per_circle,
-                         layers=sizing.mesh_part_options()["layers"] if args.backend == "gmsh" else 0)
+        mesh = mesh_with(sizing.mesh_part_options()["layers"])
         t_mesh = time.perf_counter() - t
-        path_mesh = mesh_part(part.solid, part.interfaces, across, args.thickness_mm, cache_dir=cache,
-                              backend=args.backend, elements_per_circle=per_circle,
-                              layers=SolverSettings().path_layers if args.backend == "gmsh" else 0)
+        path_mesh = None if args.no_path else mesh_with(SolverSettings().path_layers)
     stages["tessellation / BREP export"] = mesh.info["geometry_s"]
     stages["tetrahedralization (child process)"] = mesh.info["tetrahedralize_s"]
     stages["boundaries + quality"] = t_mesh - mesh.info["geometry_s"] - mesh.info["tetrahedralize_s"]
