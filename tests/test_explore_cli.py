@@ -44,8 +44,13 @@ def test_explore_command(tmp_path):
 
 
 @pytest.mark.slow  # two explorations of one full path each
-def test_explore_on_a_dask_cluster_verifies_the_same_designs(tmp_path):
+def test_explore_on_a_dask_cluster_verifies_the_same_designs(tmp_path, monkeypatch):
     pytest.importorskip("distributed")
+    from seadesign.run import executors
+
+    on_dask = []  # the tasks handed to Dask: the dask run must not fall back to local processes
+    run_dask = executors.run_dask
+    monkeypatch.setattr(executors, "run_dask", lambda fn, tasks, *a: on_dask.extend(tasks) or run_dask(fn, tasks, *a))
     study = write_tiny_study(tmp_path, name="tinyx")
     tables = {}
     for executor in ("local", "dask"):
@@ -54,6 +59,7 @@ def test_explore_on_a_dask_cluster_verifies_the_same_designs(tmp_path):
                                            "--executor", executor, "--quiet", "--out", str(out),
                                            "--cache-dir", str(tmp_path / f"cache-{executor}")])
         assert result.exit_code == 0, result.output
+        assert bool(on_dask) == (executor == "dask"), executor
         tables[executor] = pd.read_csv(out / "tinyx" / "results.csv")
     local, dask = tables["local"], tables["dask"]
     assert dask["candidate"].tolist() == local["candidate"].tolist() == ["3 beams x 8 mm"]
