@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from helpers_annulus import annulus_mesh
 from helpers_skfem import skfem_permutation
 from skfem import asm
@@ -113,3 +114,27 @@ def test_pardiso_refuses_a_matrix_that_is_not_positive_definite(small):
     k = cpl.condense(stiffness_upper(emesh, E, NU, cpl.node_index, cpl.n_rows)).matrix()
     with pytest.raises(SolverError, match="not positive definite"):
         SPDFactorization(-k)
+
+
+@pytest.mark.parametrize("negatives", [0, 1, 7])
+def test_pardiso_inertia_counts_the_negative_eigenvalues(small, negatives):
+    """The LDL^T inertia (which decides a path's stability) against LAPACK's eigenvalues: the coupled
+    stiffness shifted so that `negatives` (or the next count between distinct eigenvalues) fall below zero."""
+    from seadesign.fea.pardiso import Pardiso
+
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    r = np.hypot(*emesh.nodes_m[:, :2].T)
+    cpl = couple(emesh.nodes_m, np.flatnonzero(r < 0.0051), np.flatnonzero(r > 0.0119), np.zeros(3))
+    k = cpl.condense(stiffness_upper(emesh, E, NU, cpl.node_index, cpl.n_rows)).matrix()
+    ev = np.linalg.eigvalsh(full_from_upper(k).toarray())  # the annulus's symmetry pairs some of them
+    while negatives and ev[negatives] - ev[negatives - 1] < 1e-3 * ev[negatives]:
+        negatives += 1  # a shift inside a double eigenvalue would not say how many fall below it
+    shift = 0.5 * (ev[negatives - 1] + ev[negatives]) if negatives else 0.5 * ev[0]
+    shifted = (k.tocsr() - shift * sp.eye(k.shape[0], format="csr")).tobsr(blocksize=(3, 3))
+    ldl = Pardiso(shifted, indefinite=True)
+    try:
+        positive, negative, perturbed = ldl.inertia()
+    finally:
+        ldl.close()
+    assert (positive, negative, perturbed) == (k.shape[0] - negatives, negatives, 0)
