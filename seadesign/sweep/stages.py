@@ -46,6 +46,8 @@ class SolverSettings:
     # its in-plane sizing is the result mesh's, which resolves the beam-root fillets where contact and
     # creases start (README: a 2x coarser mesh put contact 11-26 % late)
     path_formulation: str = "full"  # volumetric formulation of the path (fea.finite_strain), as CalculiX's C3D10
+    k_error_estimate: bool = True  # solve k on a COARSENING times coarser mesh too (k's discretization error); the
+    # explorer, which judges designs on their paths, makes it only for the design it reports
 
 
 @dataclass(frozen=True)
@@ -54,7 +56,7 @@ class UnitResponse:
     estimate's coarse k, and how the mesh and solve went."""
 
     results: LinearResults  # both load cases at 1 Nm
-    k_coarse_Nm_per_rad: float  # k on a COARSENING times coarser mesh (error estimate of k)
+    k_coarse_Nm_per_rad: float  # k on a COARSENING times coarser mesh (error estimate of k; NaN: not made)
     time_fea_total_s: float
     time_error_estimate_s: float
     mesh_mean_aspect_ratio: float
@@ -79,7 +81,7 @@ def fea_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str
     this module with everything it imports (the solver, the mesher, the study's mesh sizing)."""
     m = candidate.material
     return digest("fea", mesh_key(study, candidate), m.youngs_modulus_Pa, m.poisson_ratio,
-                  settings.element_order, settings.linear_solver,
+                  settings.element_order, settings.linear_solver, settings.k_error_estimate,
                   code_fingerprint("seadesign.sweep.stages", "seadesign.mesh.worker"), package_versions())
 
 
@@ -111,7 +113,7 @@ def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache,
 
 
 def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, settings: SolverSettings) -> UnitResponse:
-    """Both load cases at 1 Nm, and k on the coarse mesh for the error estimate."""
+    """Both load cases at 1 Nm, and k on the coarse mesh for the error estimate (none without a coarse mesh)."""
     from seadesign.fea.loadcases import analyse
     from seadesign.fea.torsion import solve_unit_torsion
 
@@ -120,11 +122,14 @@ def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, setting
     a = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, 1.0, 1.0, study.bearing_radius_mm,
                 order=settings.element_order, linear_solver=settings.linear_solver)
     t1 = time.perf_counter()
-    coarse = solve_unit_torsion(coarse_mesh, m.youngs_modulus_Pa, m.poisson_ratio, order=settings.element_order,
-                                linear_solver=settings.linear_solver)
+    k_coarse = float("nan")
+    if coarse_mesh is not None:
+        coarse = solve_unit_torsion(coarse_mesh, m.youngs_modulus_Pa, m.poisson_ratio, order=settings.element_order,
+                                    linear_solver=settings.linear_solver)
+        k_coarse = 1.0 / float(coarse.hub_motion[5])
     return UnitResponse(
         results=a.results,
-        k_coarse_Nm_per_rad=1.0 / float(coarse.hub_motion[5]),
+        k_coarse_Nm_per_rad=k_coarse,
         time_fea_total_s=t1 - t0,
         time_error_estimate_s=time.perf_counter() - t1,
         mesh_mean_aspect_ratio=mesh.quality.mean_aspect_ratio,
@@ -157,7 +162,7 @@ def fea_response(study: Study, candidate: Candidate, part: Callable[[], Part], s
         return unit
     progress("mesh")
     mesh = tetrahedralize(study, candidate, part(), cache)
-    coarse_mesh = tetrahedralize(study, candidate, part(), cache, COARSENING)
+    coarse_mesh = tetrahedralize(study, candidate, part(), cache, COARSENING) if settings.k_error_estimate else None
     progress("fea")
     unit = unit_response(mesh, coarse_mesh, study, candidate, settings)
     cache.put("fea", fkey, unit)
