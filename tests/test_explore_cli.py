@@ -33,14 +33,17 @@ def test_explore_command(tmp_path):
     assert not t["feasible"].any() and "carries the stall torque" in t.loc[0, "failed_constraints"]
     spring = load_spring(folder / "spring.json")
     assert spring["design"]["beam_count"] == 3 and spring["selection"]["feasible"] is False
-    # the evaluations skip k's error estimate (the stored evaluation row has none); the reported design gets it
+    # the evaluations skip k's error estimate (the stored evaluation row has none); the reported design gets it, and
+    # the coarser mesh is the stiffer one (a conforming displacement model)
     stored = [json.loads(p.read_text()) for p in (folder / "rows").glob("*.json")]
-    assert sorted(pd.isna(r["k_rel_error"]) for r in stored if r.get("k_Nm_per_rad")) == [False, True]
-    assert 0 <= t.loc[0, "k_rel_error"] < 0.05 and spring["k_rel_error"] == pytest.approx(t.loc[0, "k_rel_error"])
+    assert [pd.isna(r["k_rel_error"]) for r in stored if r.get("k_Nm_per_rad")] == [True]
+    assert 0 < t.loc[0, "k_rel_error"] < 0.05 and spring["k_rel_error"] == pytest.approx(t.loc[0, "k_rel_error"])
+    assert t.loc[0, "k_coarse_Nm_per_rad"] > t.loc[0, "k_Nm_per_rad"]
     for name in ("front.csv", "surrogate_loo.csv", "sobol.csv", "parallel_coordinates.png", "history.png",
                  "torque_curves.png", "3beams_8mm.stl", "3beams_8mm.step", "report.md"):
         assert (folder / name).is_file(), name
-    assert json.loads((folder / "settings.json").read_text())["loop"]["budget"] == 2
+    settings = json.loads((folder / "settings.json").read_text())
+    assert settings["loop"]["budget"] == 2 and settings["solver"]["k_error_estimate"] == "the reported design only"
     seen = assert_readable(folder / "report.html")
     assert seen["decision"]["text"].startswith("No solved design meets every requirement. The nearest, 3 beams x 8 mm")
     rerun = CliRunner().invoke(main, args)  # every evaluation and screening comes back from the stored rows

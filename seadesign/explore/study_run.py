@@ -10,7 +10,6 @@ from pathlib import Path
 import pandas as pd
 
 from seadesign.design.study import Study
-from seadesign.errors import SolverError
 from seadesign.explore.decision import Decision, decide
 from seadesign.explore.loop import Exploration, LoopSettings, explore
 from seadesign.explore.sensitivity import sobol_indices
@@ -18,8 +17,9 @@ from seadesign.explore.spring_problem import SpringProblem
 from seadesign.run.cache import Cache
 from seadesign.run.progress import ProgressDisplay
 from seadesign.sweep.requirements import OBJECTIVE_WORDS, requirement_list
-from seadesign.sweep.runner import run_candidates, sweep_settings
-from seadesign.sweep.stages import SolverSettings
+from seadesign.sweep.runner import sweep_settings
+from seadesign.sweep.stages import SolverSettings, check_geometry, coarse_k, part_source
+from seadesign.sweep.table import k_error_columns
 
 
 @dataclass
@@ -58,23 +58,19 @@ def explore_study(study: Study, out_dir: Path, loop: LoopSettings, *, solver: So
     if decision.index is not None and solver.k_error_estimate:
         estimate_k_error(problem, exploration.evaluated, decision.index, solver)
     sobol = sobol_indices(problem.encoding, exploration.models, problem.outputs, loop.seed)
-    settings = {**sweep_settings(study, problem.settings), "requirements": asdict(study.requirements),
-                "loop": asdict(loop), "k_error_estimate": "the reported design only"}
+    settings = sweep_settings(study, problem.settings)
+    settings["solver"]["k_error_estimate"] = "the reported design only" if solver.k_error_estimate else False
+    settings.update(requirements=asdict(study.requirements), loop=asdict(loop))
     return StudyExploration(problem, exploration, decision, sobol, settings, time.perf_counter() - t0)
 
 
-K_ERROR_COLUMNS = ("k_coarse_Nm_per_rad", "k_rel_error", "time_error_estimate_s")
-
-
 def estimate_k_error(problem: SpringProblem, evaluated: pd.DataFrame, index, solver: SolverSettings) -> None:
-    """k's discretization error of the reported design, which the evaluations skip: its linear stage again with the
-    coarse solve (its path comes from the cache); the row's K_ERROR_COLUMNS are updated in place."""
+    """k's discretization error of the reported design, which the evaluations skip: its coarse-k stage (`sweep.stages.
+    coarse_k`, cached); the row's k-error columns are updated in place."""
     x = evaluated.loc[index, [f"x{i}" for i in range(len(problem.encoding.keys))]].to_numpy(float)
     (candidate, _), = problem.candidates(x)
-    row = run_candidates(problem.study, [candidate], problem.out_dir, settings=solver, cache=problem.cache,
-                         executor="serial", quiet=True).rows.iloc[0]
-    if row["status"] != "ok" or abs(row["k_Nm_per_rad"] / evaluated.loc[index, "k_Nm_per_rad"] - 1.0) > 1e-9:
-        raise SolverError(f"{candidate.name}: the error-estimate run of the reported design did not reproduce its "
-                          f"evaluation ({row['status']}: {row.get('reason', '')})")
-    for column in K_ERROR_COLUMNS:
-        evaluated.loc[index, column] = row[column]
+    checked, part = check_geometry(problem.study, candidate, problem.cache)
+    coarse = coarse_k(problem.study, checked, part_source(problem.study, checked, part, lambda _: None), solver,
+                      problem.cache, lambda _: None)
+    for column, value in k_error_columns(coarse, evaluated.loc[index, "k_Nm_per_rad"]).items():
+        evaluated.loc[index, column] = value

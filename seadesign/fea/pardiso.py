@@ -1,6 +1,11 @@
 """A small ctypes binding to MKL PARDISO (libmkl_rt from the `mkl` wheel) for symmetric
 positive-definite matrices stored as their upper triangle, in CSR or in 3x3-block BSR.
 
+MKL runs in conditional-numerical-reproducibility mode (MKL_CBWR=AUTO unless the environment sets
+MKL_CBWR): with more than one thread, PARDISO's factorization otherwise differs in the last digits from
+run to run (a large-deflection path by 1e-13 Nm), and the explorer, which fits its surrogates on those
+digits, took another route on every run. Results still depend on the number of threads.
+
 Block storage matters: PARDISO then orders the node graph, nine times smaller than the
 scalar one (on a 374k-dof spring: analysis 1.0 s instead of 4.1 s, factorization 4.0 s
 instead of 5.7 s).
@@ -27,6 +32,7 @@ _ERRORS = {
     -4: "zero or negative pivot: the matrix is not positive definite (under-constrained structure?)",
     -8: "32-bit integer overflow: the problem is too large",
 }
+_CBWR_AUTO = 2  # MKL_CBWR_AUTO: conditional numerical reproducibility on the code branch MKL picks for this CPU
 _P = ctypes.POINTER
 _I32 = ctypes.c_int32
 
@@ -47,6 +53,9 @@ def _library() -> ctypes.CDLL:
                                 _P(_I32), _P(_I32), _P(_I32), _P(_I32), ctypes.c_void_p, ctypes.c_void_p, _P(_I32)]
         lib.pardisoinit.restype = None
         lib.pardisoinit.argtypes = [_P(ctypes.c_int64), _P(_I32), _P(_I32)]
+        lib.MKL_CBWR_Set.restype, lib.MKL_CBWR_Set.argtypes = ctypes.c_int, [ctypes.c_int]
+        if "MKL_CBWR" not in os.environ and lib.MKL_CBWR_Set(_CBWR_AUTO) != 0:
+            raise SolverError(f"{path}: MKL refused conditional numerical reproducibility (MKL_CBWR_Set)")
         return lib
     raise SolverError("MKL PARDISO not found: `pip install mkl`, or choose linear_solver='scipy'")
 

@@ -57,10 +57,9 @@ def run_processes(fn, tasks: list, jobs: int, on_stage: Callable[[Any, str], Non
     When the caller stops (Ctrl-C, SIGTERM, an error), pending tasks are cancelled and the worker
     processes are killed with everything they started, without waiting for running tasks."""
     ctx = mp.get_context("spawn")
-    threads = str(max(1, default_jobs() // jobs))  # solver threads per worker: no oversubscription
-    with _environment(MKL_NUM_THREADS=threads, OMP_NUM_THREADS=threads):
-        manager = ctx.Manager()
-        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=ignore_sigint)
+    threads = max(1, default_jobs() // jobs)  # solver threads per worker: no oversubscription
+    manager = ctx.Manager()
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_worker, initargs=(threads,))
     finished = False
     try:
         sink = manager.Queue()
@@ -82,17 +81,20 @@ def run_processes(fn, tasks: list, jobs: int, on_stage: Callable[[Any, str], Non
             killed.extend(kill_trees(workers + [manager._process.pid]))  # noqa: SLF001
 
 
-@contextlib.contextmanager
-def _environment(**values: str):
-    """Environment variables set while worker processes are spawned (they inherit them); the
-    caller's own values are respected."""
-    added = {k: v for k, v in values.items() if k not in os.environ}
-    os.environ.update(added)
-    try:
-        yield
-    finally:
-        for k in added:
-            os.environ.pop(k, None)
+THREAD_VARIABLES = ("MKL_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+
+
+def _init_worker(threads: int) -> None:
+    """A local worker: Ctrl-C is the parent's to handle, and the math libraries use `threads` threads (unless the
+    caller's environment sets their variables): in the environment for MKL, which loads later, and through
+    threadpoolctl for what the worker's imports already loaded (NumPy's OpenBLAS)."""
+    from threadpoolctl import threadpool_limits
+
+    ignore_sigint()
+    unset = [name for name in THREAD_VARIABLES if name not in os.environ]
+    os.environ.update({name: str(threads) for name in unset})
+    if unset:
+        threadpool_limits(threads)
 
 
 def _drain(sink, on_stage: Callable[[Any, str], None]) -> None:

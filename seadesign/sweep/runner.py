@@ -30,7 +30,8 @@ from seadesign.run.executors import default_jobs, execute
 from seadesign.run.interrupt import Interrupted, remove_partial_files
 from seadesign.run.progress import ProgressDisplay
 from seadesign.sweep.path_stage import path_key, path_response
-from seadesign.sweep.stages import SolverSettings, check_geometry, fea_key, fea_response, geometry_key, part_source
+from seadesign.sweep.stages import (SolverSettings, check_geometry, coarse_k, fea_key, fea_response, geometry_key,
+                                    part_source)
 from seadesign.sweep.table import candidate_columns, fea_columns, geometry_columns, path_columns
 
 
@@ -70,7 +71,7 @@ def row_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str
     solver, large-deflection path, versions) and of the code that turns the stage outputs into the row
     (this module and the table's columns)."""
     return digest("row", candidate.values, fea_key(study, candidate, settings), path_key(study, candidate, settings),
-                  geometry_key(study, candidate),
+                  settings.k_error_estimate, geometry_key(study, candidate),
                   study.load_cases, study.bearing_radius_mm, candidate.material, code_fingerprint(__name__))
 
 
@@ -98,7 +99,9 @@ def evaluate(job: Job, sink) -> dict:
         elif not job.screen:
             part_of = part_source(job.study, checked, part, stage)
             unit = fea_response(job.study, checked, part_of, job.settings, job.cache, stage)
-            row.update(fea_columns(unit, job.study))
+            coarse = (coarse_k(job.study, checked, part_of, job.settings, job.cache, stage)
+                      if job.settings.k_error_estimate else None)
+            row.update(fea_columns(unit, coarse, job.study))
             row.update(path_columns(path_response(job.study, checked, part_of, job.settings, job.cache, stage), job.study))
     except Exception as exc:  # noqa: BLE001 - a failing candidate is a result, not a crash
         row.update(status="failed", reason=f"{type(exc).__name__}: {exc}".strip(),

@@ -8,8 +8,8 @@ changing one input recomputes only the stages that depend on it. The FEA is solv
 columns are made from these objects in `sweep/table.py`.
 
 Meshing is `seadesign.mesh.mesh_part`, the solve `seadesign.fea.loadcases.analyse` at 1 Nm per
-load case; a second P2 solve on a mesh COARSENING times coarser gives the discretization-error
-estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest order observed in
+load case; a second P2 solve on a mesh COARSENING times coarser (`coarse_k`, a stage of its own)
+gives the discretization-error estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest order observed in
 benchmarks/fea_convergence.py).
 """
 
@@ -46,22 +46,28 @@ class SolverSettings:
     # its in-plane sizing is the result mesh's, which resolves the beam-root fillets where contact and
     # creases start (README: a 2x coarser mesh put contact 11-26 % late)
     path_formulation: str = "full"  # volumetric formulation of the path (fea.finite_strain), as CalculiX's C3D10
-    k_error_estimate: bool = True  # solve k on a COARSENING times coarser mesh too (k's discretization error); the
-    # explorer, which judges designs on their paths, makes it only for the design it reports
+    k_error_estimate: bool = True  # solve k on a COARSENING times coarser mesh too (k's discretization error,
+    # `coarse_k`); the explorer, which judges designs on their paths, makes it only for the design it reports
 
 
 @dataclass(frozen=True)
 class UnitResponse:
-    """The FEA of one candidate at 1 Nm in each load case (scale with `results.at`), the error
-    estimate's coarse k, and how the mesh and solve went."""
+    """The FEA of one candidate at 1 Nm in each load case (scale with `results.at`) and how the mesh
+    and solve went."""
 
     results: LinearResults  # both load cases at 1 Nm
-    k_coarse_Nm_per_rad: float  # k on a COARSENING times coarser mesh (error estimate of k; NaN: not made)
     time_fea_total_s: float
-    time_error_estimate_s: float
     mesh_mean_aspect_ratio: float
     mesh_target_edge_mm: float
     mesh_tetrahedralize_s: float
+
+
+@dataclass(frozen=True)
+class CoarseK:
+    """k on a COARSENING times coarser mesh: with the result mesh's k, the error estimate of k."""
+
+    k_coarse_Nm_per_rad: float
+    time_s: float
 
 
 def geometry_key(study: Study, candidate: Candidate) -> str:
@@ -81,8 +87,13 @@ def fea_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str
     this module with everything it imports (the solver, the mesher, the study's mesh sizing)."""
     m = candidate.material
     return digest("fea", mesh_key(study, candidate), m.youngs_modulus_Pa, m.poisson_ratio,
-                  settings.element_order, settings.linear_solver, settings.k_error_estimate,
+                  settings.element_order, settings.linear_solver,
                   code_fingerprint("seadesign.sweep.stages", "seadesign.mesh.worker"), package_versions())
+
+
+def coarse_k_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
+    """Inputs of the coarse k: those of the unit response and the coarsening."""
+    return digest("coarse_k", fea_key(study, candidate, settings), COARSENING)
 
 
 def check_geometry(study: Study, candidate: Candidate, cache: Cache) -> tuple[Candidate, Part | None]:
@@ -112,26 +123,17 @@ def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache,
                      cache_dir=Path(cache.root) / "mesh", **options)
 
 
-def unit_response(mesh, coarse_mesh, study: Study, candidate: Candidate, settings: SolverSettings) -> UnitResponse:
-    """Both load cases at 1 Nm, and k on the coarse mesh for the error estimate (none without a coarse mesh)."""
+def unit_response(mesh, study: Study, candidate: Candidate, settings: SolverSettings) -> UnitResponse:
+    """Both load cases at 1 Nm."""
     from seadesign.fea.loadcases import analyse
-    from seadesign.fea.torsion import solve_unit_torsion
 
     m = candidate.material
     t0 = time.perf_counter()
     a = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, 1.0, 1.0, study.bearing_radius_mm,
                 order=settings.element_order, linear_solver=settings.linear_solver)
-    t1 = time.perf_counter()
-    k_coarse = float("nan")
-    if coarse_mesh is not None:
-        coarse = solve_unit_torsion(coarse_mesh, m.youngs_modulus_Pa, m.poisson_ratio, order=settings.element_order,
-                                    linear_solver=settings.linear_solver)
-        k_coarse = 1.0 / float(coarse.hub_motion[5])
     return UnitResponse(
         results=a.results,
-        k_coarse_Nm_per_rad=k_coarse,
-        time_fea_total_s=t1 - t0,
-        time_error_estimate_s=time.perf_counter() - t1,
+        time_fea_total_s=time.perf_counter() - t0,
         mesh_mean_aspect_ratio=mesh.quality.mean_aspect_ratio,
         mesh_target_edge_mm=mesh.info.get("target_edge_mm", float("nan")),
         mesh_tetrahedralize_s=mesh.info.get("tetrahedralize_s", float("nan")),
@@ -162,8 +164,29 @@ def fea_response(study: Study, candidate: Candidate, part: Callable[[], Part], s
         return unit
     progress("mesh")
     mesh = tetrahedralize(study, candidate, part(), cache)
-    coarse_mesh = tetrahedralize(study, candidate, part(), cache, COARSENING) if settings.k_error_estimate else None
     progress("fea")
-    unit = unit_response(mesh, coarse_mesh, study, candidate, settings)
+    unit = unit_response(mesh, study, candidate, settings)
     cache.put("fea", fkey, unit)
     return unit
+
+
+def coarse_k(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings, cache: Cache,
+             progress: Progress) -> CoarseK:
+    """k on the COARSENING times coarser mesh via the cache (its own stage: the explorer asks for it only for
+    the design it reports)."""
+    from seadesign.fea.torsion import solve_unit_torsion
+
+    key = coarse_k_key(study, candidate, settings)
+    hit = cache.get("coarse_k", key)
+    if hit is not None:
+        return hit
+    progress("mesh")
+    mesh = tetrahedralize(study, candidate, part(), cache, COARSENING)
+    progress("fea")
+    m = candidate.material
+    t0 = time.perf_counter()
+    coarse = solve_unit_torsion(mesh, m.youngs_modulus_Pa, m.poisson_ratio, order=settings.element_order,
+                                linear_solver=settings.linear_solver)
+    result = CoarseK(1.0 / float(coarse.hub_motion[5]), time.perf_counter() - t0)
+    cache.put("coarse_k", key, result)
+    return result

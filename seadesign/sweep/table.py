@@ -15,7 +15,7 @@ from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
 from seadesign.fea.results import columns
 from seadesign.sweep.path_stage import PathResponse
-from seadesign.sweep.stages import COARSENING, CONVERGENCE_ORDER, UnitResponse
+from seadesign.sweep.stages import COARSENING, CONVERGENCE_ORDER, CoarseK, UnitResponse
 
 
 def candidate_columns(candidate: Candidate, row_key: str) -> dict:
@@ -28,7 +28,18 @@ def geometry_columns(candidate: Candidate) -> dict:
     return {"volume_mm3": candidate.volume_mm3, "mass_g": candidate.mass_kg * 1e3}
 
 
-def fea_columns(unit: UnitResponse, study: Study) -> dict[str, float]:
+def k_error_columns(coarse: CoarseK | None, k_Nm_per_rad: float) -> dict[str, float]:
+    """k on the coarser mesh and k's relative discretization error (NaN: no coarse solve)."""
+    k_coarse = math.nan if coarse is None else coarse.k_coarse_Nm_per_rad
+    return {
+        "k_coarse_Nm_per_rad": k_coarse,
+        # two-level Richardson: error of k_h ~ |k_h - k_rh| / (r^p - 1)
+        "k_rel_error": abs(k_coarse - k_Nm_per_rad) / k_Nm_per_rad / (COARSENING**CONVERGENCE_ORDER - 1.0),
+        "time_error_estimate_s": math.nan if coarse is None else coarse.time_s,
+    }
+
+
+def fea_columns(unit: UnitResponse, coarse: CoarseK | None, study: Study) -> dict[str, float]:
     """Both load cases of the study from the 1 Nm results (the model is linear), units in the names.
 
     Stall: the servo's stall torque on the hub; the bearing displacement is read on the bearing
@@ -41,13 +52,10 @@ def fea_columns(unit: UnitResponse, study: Study) -> dict[str, float]:
     return {
         **r.columns(),
         "time_fea_total_s": unit.time_fea_total_s,
-        "time_error_estimate_s": unit.time_error_estimate_s,
         "impact_rotation_rad": lc.impact_torque_Nm / k,
         "stall_rotation_deg": math.degrees(r.stall.rotation_rad),
         "stall_foot_error_mm": r.stall.bearing_displacement_mm / study.bearing_radius_mm * lc.lower_leg_m * 1e3,
-        "k_coarse_Nm_per_rad": unit.k_coarse_Nm_per_rad,
-        # two-level Richardson: error of k_h ~ |k_h - k_rh| / (r^p - 1)
-        "k_rel_error": abs(unit.k_coarse_Nm_per_rad - k) / k / (COARSENING**CONVERGENCE_ORDER - 1.0),
+        **k_error_columns(coarse, k),
         "mesh_mean_aspect_ratio": unit.mesh_mean_aspect_ratio,
         "mesh_target_edge_mm": unit.mesh_target_edge_mm,
         "mesh_tetrahedralize_s": unit.mesh_tetrahedralize_s,

@@ -1,0 +1,27 @@
+"""The local process pool: each worker's math libraries get their share of the cores."""
+
+from __future__ import annotations
+
+import ctypes
+
+from seadesign.run.executors import default_jobs, execute
+
+
+def _threads(task, sink) -> tuple[int, int]:
+    """(MKL's threads, OpenBLAS's threads) as a worker sees them."""
+    from threadpoolctl import threadpool_info
+
+    from seadesign.fea.pardiso import _library
+
+    mkl = _library()
+    mkl.MKL_Get_Max_Threads.restype = ctypes.c_int
+    blas = [i["num_threads"] for i in threadpool_info() if i["internal_api"] == "openblas"]
+    return mkl.MKL_Get_Max_Threads(), min(blas)
+
+
+def test_local_workers_use_their_share_of_the_cores(monkeypatch):
+    for name in ("MKL_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+        monkeypatch.delenv(name, raising=False)
+    share = max(1, default_jobs() // 2)
+    results = [r for _, r in execute(_threads, [0, 1], "local", 2, None, lambda *a: None, lambda: None, [])]
+    assert results == [(share, share), (share, share)]
