@@ -25,3 +25,26 @@ def test_local_workers_use_their_share_of_the_cores(monkeypatch):
     share = max(1, default_jobs() // 2)
     results = [r for _, r in execute(_threads, [0, 1], "local", 2, None, lambda *a: None, lambda: None, [])]
     assert results == [(share, share), (share, share)]
+
+
+def _pid(task, sink) -> int:
+    import os
+
+    return os.getpid()
+
+
+def _pids() -> set[int]:
+    return {r for _, r in execute(_pid, [0, 1, 2, 3], "local", 2, None, lambda *a: None, lambda: None, [])}
+
+
+def test_workers_are_kept_between_calls_only_while_asked():
+    import psutil
+
+    from seadesign.run import executors
+
+    assert _pids().isdisjoint(_pids())  # a fresh pool each call
+    with executors.keeping_workers():
+        used = _pids() | _pids()
+        kept = set(executors._kept[2][1]._processes)  # the kept pool's worker processes
+        assert used <= kept and len(kept) == 2
+    assert not any(psutil.pid_exists(p) and psutil.Process(p).status() != psutil.STATUS_ZOMBIE for p in kept)

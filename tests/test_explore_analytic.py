@@ -30,3 +30,10 @@ def test_explorer_finds_the_known_front_within_budget(problem, budget, threshold
     f1, f2, g1, g2 = p.functions(*p.designs(front[["x0", "x1"]].to_numpy(float)).T)
     assert np.allclose(front["f1"], f1) and (g1 >= 0).all() and (g2 >= 0).all()
     assert igd(front[["f1", "f2"]].to_numpy(float), problem.front()) <= threshold
+
+
+def test_surrogates_fitted_in_two_processes_take_the_same_route():
+    """The fits are independent and seeded: two processes give the same models, so the same designs."""
+    tables = [explore(BNH(), LoopSettings(budget=14, batch=2, seed=0, patience=100), jobs=jobs).evaluated
+              for jobs in (1, 2)]
+    assert tables[0].equals(tables[1])

@@ -154,8 +154,9 @@ def _moved(before: pd.DataFrame, after: pd.DataFrame, objectives: tuple[str, ...
     return bool(after[TOTAL_VIOLATION].min() < old * (1 - VIOLATION_PROGRESS))
 
 
-def explore(problem: Problem, settings: LoopSettings) -> Exploration:
-    """Run the loop (see the module doc) and return every verified design, the rounds and the final models."""
+def explore(problem: Problem, settings: LoopSettings, jobs: int = 1) -> Exploration:
+    """Run the loop (see the module doc) and return every verified design, the rounds and the final models;
+    `jobs` processes fit the surrogates (the same models as one)."""
     if settings.budget < 2:
         raise ValueError(f"the budget must allow at least 2 full evaluations (got {settings.budget})")
     state = _State(problem, settings)
@@ -177,7 +178,7 @@ def explore(problem: Problem, settings: LoopSettings) -> Exploration:
         verified_F[~state.evaluated[FEASIBLE].to_numpy(bool)] = np.nan
         want = min(settings.batch, state.evaluations_left)
         with threadpool_limits(SURROGATE_THREADS):
-            models = fit_models(problem, state.evaluated, state.screened, settings.seed)
+            models = fit_models(problem, state.evaluated, state.screened, settings.seed, jobs, SURROGATE_THREADS)
             X = propose(enc, models, want, state.X(state.screened), verified_F, settings.seed + index)
         if not len(X):
             stop = "the search proposed no design that was not screened before"
@@ -200,5 +201,5 @@ def explore(problem: Problem, settings: LoopSettings) -> Exploration:
     t["front"] = front_mask(t, problem.objectives)
     t.attrs["best"] = best_index(t, problem.objectives)
     with threadpool_limits(SURROGATE_THREADS):
-        models = fit_models(problem, state.evaluated, state.screened, settings.seed)
+        models = fit_models(problem, state.evaluated, state.screened, settings.seed, jobs, SURROGATE_THREADS)
     return Exploration(t, state.screened, rounds, stop, models)

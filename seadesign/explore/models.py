@@ -49,17 +49,29 @@ class Models:
         return {c: self.surrogates[c].loo_error() for c in columns}
 
 
-def fit_models(problem: Problem, evaluated: pd.DataFrame, screened: pd.DataFrame, seed: int) -> Models:
+def _fit(model, X: np.ndarray, y: np.ndarray):
+    return model.fit(X, y)
+
+
+def fit_models(problem: Problem, evaluated: pd.DataFrame, screened: pd.DataFrame, seed: int, jobs: int = 1,
+               threads: int = 1) -> Models:
     """Fit every surrogate on the solved designs (a screened column also on every valid screened design)
-    and the classifier on every screened design; X columns are the unit-cube coordinates `x0..`."""
+    and the classifier on every screened design; X columns are the unit-cube coordinates `x0..`. The fits are
+    independent and seeded: `jobs` processes (joblib's loky, `threads` BLAS threads each) give the same models
+    as one."""
+    from joblib import Parallel, delayed, parallel_config
+
     xcols = [f"x{i}" for i in range(problem.encoding.dim)]
     solved = evaluated[evaluated[SOLVED].astype(bool)]
     valid = screened[screened[VALID].astype(bool)]
-    surrogates = {}
-    for j, column in enumerate(dict.fromkeys((*problem.objectives, *problem.margins, *problem.outputs))):
+    columns = list(dict.fromkeys((*problem.objectives, *problem.margins, *problem.outputs)))
+    tasks = [(FeasibilityClassifier(seed), screened[xcols].to_numpy(float), screened[VALID].to_numpy(bool))]  # the
+    # slowest fit first
+    for j, column in enumerate(columns):
         data = valid if column in problem.screened else solved
         positive = column not in problem.margins  # physical outputs: modelled in log space when all positive
-        surrogates[column] = Surrogate(log=positive, seed=seed + j).fit(data[xcols].to_numpy(float),
-                                                                         data[column].to_numpy(float))
-    classifier = FeasibilityClassifier(seed).fit(screened[xcols].to_numpy(float), screened[VALID].to_numpy(bool))
-    return Models(surrogates, classifier, problem.objectives, problem.margins, getattr(problem, "unjudged", None))
+        tasks.append((Surrogate(log=positive, seed=seed + j), data[xcols].to_numpy(float), data[column].to_numpy(float)))
+    with parallel_config(backend="loky", inner_max_num_threads=threads):
+        classifier, *fitted = Parallel(n_jobs=jobs)(delayed(_fit)(*task) for task in tasks)
+    return Models(dict(zip(columns, fitted)), classifier, problem.objectives, problem.margins,
+                  getattr(problem, "unjudged", None))

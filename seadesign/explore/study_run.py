@@ -15,6 +15,7 @@ from seadesign.explore.loop import Exploration, LoopSettings, explore
 from seadesign.explore.sensitivity import sobol_indices
 from seadesign.explore.spring_problem import SpringProblem
 from seadesign.run.cache import Cache
+from seadesign.run.executors import default_jobs, keeping_workers
 from seadesign.run.progress import ProgressDisplay
 from seadesign.sweep.requirements import OBJECTIVE_WORDS, requirement_list
 from seadesign.sweep.runner import sweep_settings
@@ -50,7 +51,8 @@ def explore_study(study: Study, out_dir: Path, loop: LoopSettings, *, solver: So
     display = ProgressDisplay(loop.budget, 0, {}, quiet)
     problem = SpringProblem(study, out_dir, replace(solver, k_error_estimate=False), cache, executor, jobs, scheduler,
                             display)
-    exploration = explore(problem, loop)
+    with keeping_workers():
+        exploration = explore(problem, loop, jobs or default_jobs())
     display.close()
     words = {r.column: r.words for r in requirement_list(study)}
     decision = decide(exploration, problem.encoding, words, not_judged_reasons(study),

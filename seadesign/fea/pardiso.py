@@ -4,7 +4,8 @@ positive-definite matrices stored as their upper triangle, in CSR or in 3x3-bloc
 MKL runs in conditional-numerical-reproducibility mode (MKL_CBWR=AUTO unless the environment sets
 MKL_CBWR): with more than one thread, PARDISO's factorization otherwise differs in the last digits from
 run to run (a large-deflection path by 1e-13 Nm), and the explorer, which fits its surrogates on those
-digits, took another route on every run. Results still depend on the number of threads.
+digits, took another route on every run. Results may still depend on the number of threads (MKL promises
+reproducibility for a fixed number).
 
 Block storage matters: PARDISO then orders the node graph, nine times smaller than the
 scalar one (on a 374k-dof spring: analysis 1.0 s instead of 4.1 s, factorization 4.0 s

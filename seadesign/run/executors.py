@@ -50,16 +50,48 @@ def run_serial(fn, tasks: list, on_stage: Callable[[Any, str], None], on_tick: C
         on_tick()
 
 
+_kept: dict[int, tuple] | None = None  # worker count -> (manager, pool) while `keeping_workers` is open
+
+
+@contextlib.contextmanager
+def keeping_workers():
+    """Keep the local worker processes between calls (the explorer's rounds: a fresh pool costs each round the
+    workers' start and imports, about 4 s); they are shut down on leaving."""
+    global _kept
+    if _kept is not None:  # nested: the outer block keeps them
+        yield
+        return
+    _kept = {}
+    try:
+        yield
+    finally:
+        kept, _kept = _kept, None
+        for manager, pool in kept.values():
+            pool.shutdown()
+            manager.shutdown()
+
+
+def _pool(jobs: int) -> tuple:
+    """A managed-queue manager and a pool of `jobs` "spawn" processes: kept ones when `keeping_workers` is open."""
+    if _kept is not None and jobs in _kept:
+        return _kept[jobs]
+    ctx = mp.get_context("spawn")
+    threads = max(1, default_jobs() // jobs)  # solver threads per worker: no oversubscription
+    made = (ctx.Manager(),
+            ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_worker, initargs=(threads,)))
+    if _kept is not None:
+        _kept[jobs] = made
+    return made
+
+
 def run_processes(fn, tasks: list, jobs: int, on_stage: Callable[[Any, str], None],
                   on_tick: Callable[[], None], killed: list[int]) -> Iterator:
-    """Tasks in a pool of `jobs` fresh ("spawn") processes; stage messages through a managed queue.
+    """Tasks in a pool of `jobs` processes (fresh, or kept by `keeping_workers`); stage messages through a
+    managed queue.
 
     When the caller stops (Ctrl-C, SIGTERM, an error), pending tasks are cancelled and the worker
     processes are killed with everything they started, without waiting for running tasks."""
-    ctx = mp.get_context("spawn")
-    threads = max(1, default_jobs() // jobs)  # solver threads per worker: no oversubscription
-    manager = ctx.Manager()
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_worker, initargs=(threads,))
+    manager, pool = _pool(jobs)
     finished = False
     try:
         sink = manager.Queue()
@@ -72,10 +104,12 @@ def run_processes(fn, tasks: list, jobs: int, on_stage: Callable[[Any, str], Non
             on_tick()
         finished = True
     finally:
-        if finished:
+        if finished and _kept is None:
             pool.shutdown()
             manager.shutdown()
-        else:
+        elif not finished:
+            if _kept is not None:
+                _kept.pop(jobs, None)
             workers = [p.pid for p in (pool._processes or {}).values()]  # noqa: SLF001 - no public accessor
             pool.shutdown(wait=False, cancel_futures=True)
             killed.extend(kill_trees(workers + [manager._process.pid]))  # noqa: SLF001
