@@ -65,12 +65,13 @@ def fit_models(problem: Problem, evaluated: pd.DataFrame, screened: pd.DataFrame
     solved = evaluated[evaluated[SOLVED].astype(bool)]
     valid = screened[screened[VALID].astype(bool)]
     columns = list(dict.fromkeys((*problem.objectives, *problem.margins, *problem.outputs)))
-    tasks = [(FeasibilityClassifier(seed), screened[xcols].to_numpy(float), screened[VALID].to_numpy(bool))]  # the
-    # slowest fit first
+    # the classifier first: the slowest fit
+    tasks = [(FeasibilityClassifier(seed), screened[xcols].to_numpy(float), screened[VALID].to_numpy(bool))]
     for j, column in enumerate(columns):
         data = valid if column in problem.screened else solved
         positive = column not in problem.margins  # physical outputs: modelled in log space when all positive
-        tasks.append((Surrogate(log=positive, seed=seed + j), data[xcols].to_numpy(float), data[column].to_numpy(float)))
+        tasks.append((Surrogate(log=positive, seed=seed + j), data[xcols].to_numpy(float),
+                      data[column].to_numpy(float)))
     with parallel_config(backend="loky", inner_max_num_threads=threads):
         classifier, *fitted = Parallel(n_jobs=jobs)(delayed(_fit)(*task) for task in tasks)
     return Models(dict(zip(columns, fitted)), classifier, problem.objectives, problem.margins,

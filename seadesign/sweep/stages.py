@@ -9,8 +9,8 @@ columns are made from these objects in `sweep/table.py`.
 
 Meshing is `seadesign.mesh.mesh_part`, the solve `seadesign.fea.loadcases.analyse` at 1 Nm per
 load case; a second P2 solve on a mesh COARSENING times coarser (`coarse_k`, a stage of its own)
-gives the discretization-error estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest order observed in
-benchmarks/fea_convergence.py).
+gives the discretization-error estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest
+order observed in benchmarks/fea_convergence.py).
 """
 
 from __future__ import annotations
