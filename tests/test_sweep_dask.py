@@ -21,8 +21,9 @@ def test_dask_local_cluster_matches_serial_and_reports_stages(tmp_path, monkeypa
     monkeypatch.setattr(ProgressDisplay, "stage", lambda self, index, name: stages.append((index, name)))
     dask = run_sweep(study, tmp_path / "dask", cache=Cache(tmp_path / "c2"), executor="dask", jobs=2, quiet=True)
     assert len(dask.computed) == 2 and list(dask.rows["status"]) == ["ok", "invalid"]
-    assert sorted(stages) == [(0, "fea"), (0, "geometry"), (0, "mesh"), (0, "mesh"), (0, "path"),
-                              (1, "geometry")]  # worker stages arrived (the path meshes its own one-layer mesh)
+    assert sorted(stages) == [(0, "fea"), (0, "fea"), (0, "geometry"), (0, "mesh"), (0, "mesh"), (0, "mesh"),
+                              (0, "path"), (1, "geometry")]  # worker stages arrived (k's error estimate meshes and
+    # solves a coarser mesh, the path meshes its own one-layer mesh)
     cols = ["candidate", "status", "reason", "volume_mm3", "row_key"]
     assert dask.rows[cols].equals(serial.rows[cols])
     # the same mesh and solve in another process: k and the stresses agree to round-off
