@@ -96,3 +96,15 @@ def igd(obtained: np.ndarray, reference: np.ndarray) -> float:
     lo, span = reference.min(axis=0), np.ptp(reference, axis=0)
     R, A = (reference - lo) / span, (np.asarray(obtained) - lo) / span
     return float(np.mean(np.min(np.linalg.norm(R[:, None, :] - A[None, :, :], axis=2), axis=1)))
+
+
+
+class StripedBNH(BNH):
+    """BNH whose designs with x1 in stripes (the first 30 % of every twentieth of its range) cannot be built:
+    screening finds them invalid. The stripes are finer than a classifier learns from a few dozen designs,
+    so proposals keep screening invalid."""
+
+    STRIPES, INVALID_FRACTION = 20, 0.3
+
+    def screen(self, X: np.ndarray) -> pd.DataFrame:
+        return pd.DataFrame({"valid": np.mod(self.STRIPES * np.asarray(X)[:, 0], 1.0) >= self.INVALID_FRACTION})

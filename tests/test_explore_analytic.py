@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from helpers_analytic import BNH, TNK, igd
+from helpers_analytic import BNH, TNK, StripedBNH, igd
 from seadesign.explore.loop import LoopSettings, explore
 
 
@@ -37,3 +37,15 @@ def test_surrogates_fitted_in_two_processes_take_the_same_route():
     tables = [explore(BNH(), LoopSettings(budget=14, batch=2, seed=0, patience=100), jobs=jobs).evaluated
               for jobs in (1, 2)]
     assert tables[0].equals(tables[1])
+
+
+def test_a_round_replaces_proposals_that_screen_invalid_and_verifies_a_full_batch():
+    """Where designs cannot be built, proposals screen invalid; each round replaces them from the search's
+    spares, so every round but the last (the budget's remainder) verifies the whole batch."""
+    result = explore(StripedBNH(), LoopSettings(budget=24, batch=3, seed=0, patience=100))
+    screened, evaluated = result.screened, result.evaluated
+    searched = screened[screened["round"] > 0]
+    assert (~searched["valid"].astype(bool)).sum() >= 6  # the stripes were proposed: the case was exercised
+    per_round = evaluated[evaluated["round"] > 0].groupby("round").size()
+    assert (per_round.iloc[:-1] == 3).all() and len(evaluated) == 24
+    assert StripedBNH().screen(evaluated[["x0", "x1"]].to_numpy(float))["valid"].all()  # nothing unbuildable evaluated

@@ -4,14 +4,17 @@ spent or the front stops moving.
 1. The initial design (`doe.py`) is screened (cheap: geometry and validity); invalid designs are
    replaced from a space-filling pool, and the valid ones are evaluated on the full pipeline.
 2. Each round fits the surrogates on everything verified (`models.py`), searches them (`search.py`)
-   for a batch of designs, screens those, and evaluates the valid ones. Designs are only ever
-   reported from these evaluations: a surrogate steers, it never decides.
+   for a batch of designs, screens those, and evaluates the valid ones. A proposal that screens invalid
+   is replaced by the search's spares, screened in order, until the batch is full or SPARES_PER_DESIGN x the
+   batch spares are spent: the batch's designs are evaluated in parallel, and a round that verified fewer
+   would leave workers idle. Designs are only ever reported from these evaluations: a surrogate steers, it
+   never decides.
 3. Stop rule: the budget of full evaluations is spent; or `patience` rounds in a row have not moved
    the front: no newly verified design entered the verified front (a feasible design that no
    earlier feasible design dominates), or, while no design is feasible, none lowered the least total
    violation by 1 % of it or more; or the search proposes nothing that was not screened before; or the
-   screening budget (`screen_factor` x the budget) is spent. A round whose proposals all screen invalid
-   teaches the classifier and does not count as a round of the front.
+   screening budget (`screen_factor` x the budget) is spent. A round whose proposals and spares all screen
+   invalid teaches the classifier and does not count as a round of the front.
 Everything is seeded: the same problem, budget and seed give the same designs, so an interrupted
 run resumes by running again (evaluations come back from the problem's own store).
 """
@@ -33,6 +36,7 @@ from seadesign.explore.search import far_from, propose
 
 SURROGATE_THREADS = 1  # BLAS threads while fitting and searching the surrogates: their matrices are small, and
 # more threads made a round 7x slower on two busy cores
+SPARES_PER_DESIGN = 2  # replacements the search offers per design of the batch, for proposals that screen invalid
 VIOLATION_PROGRESS = 0.01  # a round that lowers the least total violation by less than this fraction does not count
 
 
@@ -179,13 +183,17 @@ def explore(problem: Problem, settings: LoopSettings, jobs: int = 1) -> Explorat
         want = min(settings.batch, state.evaluations_left)
         with threadpool_limits(SURROGATE_THREADS):
             models = fit_models(problem, state.evaluated, state.screened, settings.seed, jobs, SURROGATE_THREADS)
-            X = propose(enc, models, want, state.X(state.screened), verified_F, settings.seed + index)
+            X = propose(enc, models, want, state.X(state.screened), verified_F, settings.seed + index,
+                        SPARES_PER_DESIGN * want)
         if not len(X):
             stop = "the search proposed no design that was not screened before"
             break
         before = state.evaluated.copy()
-        valid = state.screen(X, index)[:want]
-        if not len(valid):  # every proposal was invalid: the classifier learns from them; not a round of the front
+        valid, X = state.screen(X[:want], index), X[want:]
+        while len(valid) < want and len(X) and state.screens_left > 0:  # replace the invalid ones by spares
+            missing = want - len(valid)
+            valid, X = np.vstack([valid, state.screen(X[:missing], index)]), X[missing:]
+        if not len(valid):  # every proposal and spare was invalid: the classifier learns; not a round of the front
             if state.screens_left <= 0:
                 stop = "the screening budget is spent"
                 break

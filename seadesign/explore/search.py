@@ -12,6 +12,8 @@ final population the designs to verify are, in order:
 4. the rest of the batch (at least one pick of a batch of two or more while nothing is predicted
    feasible): the designs most likely to be feasible over a space-filling sample, the margins'
    uncertainty included, so the search also looks where the surrogates are unsure.
+After the batch come `spare` further designs of step 4, in order: the loop screens them when proposals of the
+batch screen invalid, so that a round still verifies a full batch (a core is not left idle for a round).
 Designs already screened (verified, or found invalid) are never proposed again.
 """
 
@@ -86,9 +88,10 @@ def surrogate_optimum(encoding: Encoding, models: Models, seed: int):
 
 
 def propose(encoding: Encoding, models: Models, n: int, screened_X: np.ndarray, verified_F: np.ndarray,
-            seed: int) -> np.ndarray:
-    """Up to `n` designs to verify (see the module doc), none of `screened_X` (every design screened so far);
-    `verified_F` are the solved designs' objectives (rows of NaN where not feasible)."""
+            seed: int, spare: int = 0) -> np.ndarray:
+    """Up to `n` designs to verify, then up to `spare` replacements (see the module doc), none of `screened_X`
+    (every design screened so far); `verified_F` are the solved designs' objectives (rows of NaN where not
+    feasible)."""
     X, F, margins, ok = surrogate_optimum(encoding, models, seed)
     new = far_from(screened_X, X)
     X, F, margins, ok = X[new], F[new], margins[new], ok[new]
@@ -108,9 +111,10 @@ def propose(encoding: Encoding, models: Models, n: int, screened_X: np.ndarray, 
         violation = np.clip(-np.nan_to_num(margins, nan=0.0), 0, None).sum(axis=1)
         best = np.argsort(violation, kind="stable")[: max(4 * n, 1)]
         picks += [X[best[i]] for i in _spread(X[best], screened_X[:0], n - 1 if n >= 2 else n)]
-    if len(picks) < n:  # the rest of the batch: the designs most likely to be feasible, not screened yet
+    fill = n - len(picks) + spare  # the rest of the batch and the spares: the designs most likely to be feasible
+    if fill > 0:
         sample = pool(encoding, EXPLORE_SAMPLE, seed)
         sample = sample[far_from(np.vstack([screened_X, *picks]) if picks else screened_X, sample)]
         if len(sample):
-            picks += list(sample[np.argsort(-models.p_feasible(sample), kind="stable")[: n - len(picks)]])
+            picks += list(sample[np.argsort(-models.p_feasible(sample), kind="stable")[:fill]])
     return unique_rows(np.array(picks)) if picks else np.empty((0, encoding.dim))
