@@ -73,10 +73,7 @@ class Exploration:
     rounds: list[Round] = field(default_factory=list)
     stop_reason: str = ""
     models: Models | None = None  # fitted on everything verified, at the end
-
-    @property
-    def best(self):
-        return self.evaluated.attrs.get("best")
+    best: int | None = None  # row of `evaluated` chosen (`problem.best_index`); None when nothing was solved
 
 
 def _xframe(X: np.ndarray) -> pd.DataFrame:
@@ -207,7 +204,7 @@ def explore(problem: Problem, settings: LoopSettings, jobs: int = 1) -> Explorat
             break
     t = state.evaluated.copy()
     t["front"] = front_mask(t, problem.objectives)
-    t.attrs["best"] = best_index(t, problem.objectives)
+    best = best_index(t, problem.objectives)
     with threadpool_limits(SURROGATE_THREADS):
         models = fit_models(problem, state.evaluated, state.screened, settings.seed, jobs, SURROGATE_THREADS)
-    return Exploration(t, state.screened, rounds, stop, models)
+    return Exploration(t, state.screened, rounds, stop, models, None if best is None else int(best))

@@ -20,6 +20,9 @@ import pandas as pd  # noqa: E402
 from seadesign.design.space import axis_label, label  # noqa: E402
 from seadesign.sweep.rank import ACCURACY, PROTECTION  # noqa: E402
 
+LEGEND_CURVES = 8  # torque curves named in a legend at most (an explorer's front holds dozens)
+_NOT_RED = [f"C{i}" for i in range(10) if i != 3]  # the default colour cycle without its red, the choice's colour
+
 
 def _series(t: pd.DataFrame, axes: list[str]):
     """(legend text, rows sorted by the first axis) per combination of the other axes' values."""
@@ -112,17 +115,22 @@ def fig_pareto(t: pd.DataFrame, chosen: int | None, path: Path) -> Path:
 def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: float, path: Path) -> Path:
     """Torque-rotation curves of the large-deflection paths: the Pareto candidates (the ranked pool when it
     could not be scored) in colour, the other solved ones in grey; each curve's stop marked by its reason
-    (x: contact), where the peak strain passes the allowable (o), and the load torques."""
-    fig, ax = plt.subplots(figsize=(7, 4.8))
+    (x: contact), where the peak strain passes the allowable (o), and the load torques. The legend names at
+    most LEGEND_CURVES of the coloured curves: the chosen one, then the lightest."""
+    fig, ax = plt.subplots(figsize=(7, 6.2))
     solved = t[t["status"] == "ok"]
-    shown = solved[solved["pareto"].astype(bool)] if solved["pareto"].astype(bool).any() else solved[solved["rank"].notna()]
+    pareto = solved["pareto"].astype(bool)
+    shown = solved[pareto] if pareto.any() else solved[solved["rank"].notna()]
     for _, r in solved.drop(index=shown.index).iterrows():
         ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color="0.8", lw=0.8)
     markers = {"contact": "x", "limit_point": "^", "bifurcation": "v", "target_reached": "|"}
+    shown = shown.assign(_chosen=shown.index == chosen).sort_values(["_chosen", "mass_g"], ascending=[False, True],
+                                                                    kind="stable")
     for i, (_, r) in enumerate(shown.iterrows()):
-        color = "r" if chosen is not None and r.name == chosen else f"C{i % 10}"
-        ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color=color, lw=1.6,
-                label=f"{r['candidate']} ({r['large_stop_reason']})")
+        color = "r" if chosen is not None and r.name == chosen else _NOT_RED[i % len(_NOT_RED)]
+        named = i < LEGEND_CURVES
+        ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color=color, lw=1.6 if named else 0.8,
+                label=f"{r['candidate']} ({r['large_stop_reason']})" if named else None, zorder=3 if i == 0 else 2)
         ax.plot(r["large_stop_rotation_rad"], r["large_stop_torque_Nm"], markers.get(r["large_stop_reason"], "s"),
                 color=color, ms=9, mew=2)
         if np.isfinite(r["large_strain_limit_rotation_rad"]):
@@ -134,7 +142,9 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
     ax.set(xlabel="hub rotation (rad)", ylabel="torque (Nm)",
            title="Large-deflection torque curves (x: contact, o: allowable strain passed)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=6, ncol=2)
+    more = len(shown) - LEGEND_CURVES
+    ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.12),
+              title=f"{more} more in thin lines, not named" if more > 0 else None, title_fontsize=6)
     return _save(fig, path)
 
 
