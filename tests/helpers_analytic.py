@@ -98,7 +98,6 @@ def igd(obtained: np.ndarray, reference: np.ndarray) -> float:
     return float(np.mean(np.min(np.linalg.norm(R[:, None, :] - A[None, :, :], axis=2), axis=1)))
 
 
-
 class StripedBNH(BNH):
     """BNH whose designs with x1 in stripes (the first 30 % of every twentieth of its range) cannot be built:
     screening finds them invalid. The stripes are finer than a classifier learns from a few dozen designs,
