@@ -186,8 +186,8 @@ def explore(problem: Problem, settings: LoopSettings, jobs: int = 1) -> Explorat
             stop = "the search proposed no design that was not screened before"
             break
         before = state.evaluated.copy()
-        valid, X = state.screen(X[:want], index), X[want:]
-        while len(valid) < want and len(X) and state.screens_left > 0:  # replace the invalid ones by spares
+        valid = np.empty((0, enc.dim))
+        while len(valid) < want and len(X) and state.screens_left > 0:  # the batch, then spares for invalid ones
             missing = want - len(valid)
             valid, X = np.vstack([valid, state.screen(X[:missing], index)]), X[missing:]
         if not len(valid):  # every proposal and spare was invalid: the classifier learns; not a round of the front

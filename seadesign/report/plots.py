@@ -127,11 +127,11 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
     shown = shown.assign(_chosen=shown.index == chosen).sort_values(["_chosen", "mass_g"], ascending=[False, True],
                                                                     kind="stable")
     for i, (_, r) in enumerate(shown.iterrows()):
-        color = "r" if chosen is not None and r.name == chosen else _NOT_RED[i % len(_NOT_RED)]
+        color = "r" if r["_chosen"] else _NOT_RED[i % len(_NOT_RED)]
         named = i < LEGEND_CURVES
         ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color=color, lw=1.6 if named else 0.8,
                 label=f"{r['candidate']} ({r['large_stop_reason']})" if named else None,
-                zorder=3 if r.name == chosen else 2)
+                zorder=3 if r["_chosen"] else 2)
         ax.plot(r["large_stop_rotation_rad"], r["large_stop_torque_Nm"], markers.get(r["large_stop_reason"], "s"),
                 color=color, ms=9, mew=2)
         if np.isfinite(r["large_strain_limit_rotation_rad"]):
