@@ -15,3 +15,7 @@ WOLFGANG_LOWER_LEG_M = 0.2038
 XH540_STALL_TORQUE_NM = 11.7
 XH540_NO_LOAD_SPEED_RPM = 46.0
 XH540_BACKLASH_DEG = 0.25
+
+# ams AS5600 magnetic rotary encoder, the knee's deflection sensor (thesis sec. 5.2.1): 12-bit angle,
+# 0-360 deg -> 4096 counts (ams AS5600 data sheet DS000365, "12-Bit Programmable Contactless Potentiometer")
+AS5600_BITS = 12

@@ -118,18 +118,58 @@ def test_tangent_at_rest_is_the_linear_stiffness(small):
             assert 1e-3 < err
 
 
+def _neo_hooke_cauchy(F: np.ndarray) -> np.ndarray:
+    """The compressible neo-Hookean Cauchy stress in closed form: 2 C10 J^(-5/3) dev(F F^T) + 2 (J - 1) / D1 I."""
+    J, b = np.linalg.det(F), F @ F.T
+    return 2 * NEO.c10_Pa * J ** (-5 / 3) * (b - np.trace(b) / 3 * np.eye(3)) + 2 * (J - 1) / NEO.d1_per_Pa * np.eye(3)
+
+
+def _uniaxial(stretch: float) -> np.ndarray:
+    """F = diag(stretch, s, s) with the lateral Cauchy stress zero (free faces), s found by bisection."""
+    lo, hi = 0.3, 3.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lateral = _neo_hooke_cauchy(np.diag([stretch, mid, mid]))[1, 1]
+        lo, hi = (mid, hi) if lateral < 0 else (lo, mid)
+    return np.diag([stretch, 0.5 * (lo + hi), 0.5 * (lo + hi)])
+
+
+GENERAL_F = np.array([[1.3, 0.4, 0.0], [0.1, 0.9, 0.05], [0.0, -0.2, 1.1]])  # J = 1.25: every principal stress tensile
+
+
 @pytest.mark.parametrize("formulation", ["full", "mean_dilatation"])
-def test_element_strain_and_cauchy_von_mises_of_a_homogeneous_deformation(small, formulation):
-    """u = (F - I) X: every quadrature point has this F, so the peak stretch is F's largest singular value
-    and the Cauchy stress the closed-form neo-Hookean sigma = 2 C10 J^(-5/3) dev(F F^T) + 2 (J - 1) / D1 I
-    (whose von Mises is that of its deviatoric part)."""
+@pytest.mark.parametrize("F", [GENERAL_F, GENERAL_F / np.linalg.det(GENERAL_F) ** (1 / 3)], ids=["dilated", "isochoric"])
+def test_element_strain_and_cauchy_von_mises_of_a_homogeneous_deformation(small, formulation, F):
+    """u = (F - I) X: every quadrature point has this F. The principal stretches are F's singular values along
+    b = F F^T's eigenvectors n; the Cauchy stress is the closed-form neo-Hookean one, whose n sigma n signs tell
+    tension from compression (von Mises: that of its deviatoric part)."""
     points, tets = small
     emesh = element_mesh(points, tets, 2)
-    F = np.array([[1.3, 0.4, 0.0], [0.1, 0.9, 0.05], [0.0, -0.2, 1.1]])
     u = emesh.nodes_m @ (F - np.eye(3)).T
-    stretch, mises = Solid.of(emesh, NEO, formulation).element_strain_stress(u)
-    b = F @ F.T
-    dev = 2 * NEO.c10_Pa * np.linalg.det(F) ** (-5 / 3) * (b - np.trace(b) / 3 * np.eye(3))
+    result = Solid.of(emesh, NEO, formulation).element_strain_stress(u)
+    sigma = _neo_hooke_cauchy(F)
+    lam2, n = np.linalg.eigh(F @ F.T)
+    principal = np.array([n[:, i] @ sigma @ n[:, i] for i in range(3)])
+    stretch = np.sqrt(lam2)
+    tensile = max((stretch[i] - 1 for i in range(3) if principal[i] > 0), default=0.0)
+    compressive = max((1 - stretch[i] for i in range(3) if principal[i] < 0), default=0.0)
+    dev = sigma - np.trace(sigma) / 3 * np.eye(3)
     # measured: 4e-16 and 2e-15 relative (round-off)
-    assert np.allclose(stretch, np.linalg.svd(F, compute_uv=False)[0], rtol=1e-13, atol=0)
-    assert np.allclose(mises, np.sqrt(1.5 * np.sum(dev * dev)), rtol=1e-12, atol=0)
+    assert np.allclose(result.tensile_strain, tensile, rtol=1e-12, atol=0)
+    assert np.allclose(result.compressive_strain, compressive, rtol=1e-12, atol=0)
+    assert np.allclose(result.von_mises_Pa, np.sqrt(1.5 * np.sum(dev * dev)), rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("axial", [0.6, 0.85, 1.2, 1.6])
+def test_a_block_in_uniaxial_compression_has_no_tensile_strain_and_in_tension_its_stretch(small, axial):
+    """A block squeezed to `axial` with free lateral faces bulges sideways (lateral stretch > 1, zero lateral
+    stress): the tensile criterion is 0, not the bulge, and the compression is 1 - axial. Pulled, the tensile
+    criterion is axial - 1 and the lateral contraction carries no stress, so no compression counts."""
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    F = _uniaxial(axial)
+    assert F[1, 1] > 1.0 if axial < 1 else F[1, 1] < 1.0  # the bulge (or the contraction) is there
+    result = Solid.of(emesh, NEO, "full").element_strain_stress(emesh.nodes_m @ (F - np.eye(3)).T)
+    tensile, compressive = (0.0, 1 - axial) if axial < 1 else (axial - 1, 0.0)
+    assert np.allclose(result.tensile_strain, tensile, rtol=1e-12, atol=1e-12)
+    assert np.allclose(result.compressive_strain, compressive, rtol=1e-12, atol=1e-12)

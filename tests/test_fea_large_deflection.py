@@ -1,5 +1,6 @@
 """Reading a torque path at the load torques (`fea.large_deflection`) on paths made here from a closed-form
-curve T = A tanh(theta / B) (exact tangents, strain 0.5 theta), so every reading has an exact value."""
+curve T = A tanh(theta / B) (exact tangents, tensile strain 0.5 theta, compressive 0.2 theta), so every reading
+has an exact value. The repeating loads are read against a cyclic limit of 0.3, the impact against 0.433."""
 
 from __future__ import annotations
 
@@ -9,18 +10,20 @@ import numpy as np
 import pytest
 
 from seadesign.fea.elements import element_mesh
+from seadesign.design.materials import StrainLimits
 from seadesign.fea.large_deflection import large_deflection
 from seadesign.fea.results import columns
 from seadesign.fea.rotation_path import PathPoint, TorquePath, _stop_point
 
 A, B = 15.0, 0.8  # Nm, rad: initial stiffness A / B = 18.75 Nm/rad
+LIMITS = StrainLimits(cyclic=0.3, single=0.433)
 
 
 def _path(end_rad: float, reason: str, n: int = 41) -> TorquePath:
     emesh = element_mesh(np.array([[0, 0, 0], [1e-3, 0, 0], [0, 1e-3, 0], [0, 0, 2e-3]], float), np.array([[0, 1, 2, 3]]), 2)
     theta = np.linspace(0.0, end_rad, n)
     points = tuple(PathPoint(float(t), A * math.tanh(t / B), A / B / math.cosh(t / B) ** 2, 0.5 * t, math.inf, 3,
-                             (1e-9,), 0, 2e6 * t, 0) for t in theta)
+                             (1e-9,), 0, 0.2 * t, 0, 2e6 * t, 0) for t in theta)
     stop = _stop_point(list(points), reason, 1e9, 0.1)
     return TorquePath(points, reason, *stop, np.zeros((len(emesh.nodes_m), 3)), emesh, 2, 1.5)
 
@@ -30,43 +33,49 @@ def _theta(torque: float) -> float:
 
 
 def test_loads_reached_are_read_from_the_curve():
-    ld = large_deflection(_path(1.5, "target_reached"), 2.0, 11.7, 14.0, allowable_strain=0.433)
+    ld = large_deflection(_path(1.5, "target_reached"), 2.0, 11.7, 14.0, LIMITS)
     # Hermite between points 0.0375 rad apart: measured 3e-7 rad at most
     for point, torque in ((ld.standing, 2.0), (ld.stall, 11.7), (ld.impact, 14.0)):
         assert point.reached and point.rotation_rad == pytest.approx(_theta(torque), abs=1e-6)
         assert point.secant_k_Nm_per_rad == pytest.approx(torque / _theta(torque), rel=1e-5)
         assert point.tangent_k_Nm_per_rad == pytest.approx(A / B * (1 - (torque / A) ** 2), rel=2e-3)  # linear interp
-        assert point.peak_strain == pytest.approx(0.5 * _theta(torque), rel=1e-5)
-        assert point.strain_margin == pytest.approx(0.433 / (0.5 * _theta(torque)), rel=1e-5)
-    assert ld.standing.survives and not ld.impact.survives  # impact: strain 0.5 * 1.66 > 0.433
-    assert ld.strain_limit_rotation_rad == pytest.approx(0.866, abs=1e-9)
-    assert ld.strain_limit_torque_Nm == pytest.approx(A * math.tanh(0.866 / B), rel=1e-3)
-    assert ld.peak_strain == pytest.approx(0.75) and ld.peak_von_mises_MPa == pytest.approx(3.0)
-    assert ld.peak_log_strain == pytest.approx(math.log(1.75))
+        assert point.tensile_strain == pytest.approx(0.5 * _theta(torque), rel=1e-5)
+        assert point.compressive_strain == pytest.approx(0.2 * _theta(torque), rel=1e-5)
+        limit = 0.433 if point is ld.impact else 0.3
+        assert point.strain_limit == limit
+        assert point.strain_margin == pytest.approx(limit / (0.5 * _theta(torque)), rel=1e-5)
+    # standing: 0.054 of 0.3; stall: 0.5 x 0.836 = 0.418 > 0.3 cyclic; impact: 0.5 x 1.345 = 0.672 > 0.433
+    assert ld.standing.survives and not ld.stall.survives and not ld.impact.survives
+    assert ld.cyclic_limit_rotation_rad == pytest.approx(0.6, abs=1e-9)
+    assert ld.cyclic_limit_torque_Nm == pytest.approx(A * math.tanh(0.6 / B), rel=1e-3)
+    assert ld.single_limit_rotation_rad == pytest.approx(0.866, abs=1e-9)
+    assert ld.single_limit_torque_Nm == pytest.approx(A * math.tanh(0.866 / B), rel=1e-3)
+    assert ld.peak_tensile_strain == pytest.approx(0.75) and ld.peak_compressive_strain == pytest.approx(0.3)
+    assert ld.peak_von_mises_MPa == pytest.approx(3.0)
     assert math.isnan(ld.contact_rotation_rad) and ld.increments == 40 and ld.newton_iterations == 123
 
 
 def test_a_load_past_the_stop_is_not_extrapolated_unless_contact_is_an_end_stop():
     path = _path(0.5, "contact")  # stops at 0.5 rad, 8.29 Nm: below the stall torque
-    ld = large_deflection(path, 2.0, 11.7, 14.0, allowable_strain=0.433)
+    ld = large_deflection(path, 2.0, 11.7, 14.0, LIMITS)
     assert ld.contact_rotation_rad == 0.5 and ld.contact_torque_Nm == pytest.approx(A * math.tanh(0.5 / B))
     assert ld.standing.survives
     for point in (ld.stall, ld.impact):
         assert not point.reached and not point.survives and math.isnan(point.rotation_rad)
-    stop = large_deflection(path, 2.0, 11.7, 14.0, allowable_strain=0.433, contact_is_end_stop=True)
+    stop = large_deflection(path, 2.0, 11.7, 14.0, LIMITS, contact_is_end_stop=True)
     assert not stop.stall.reached and stop.stall.survives and stop.stall.rotation_rad == 0.5
-    assert stop.stall.peak_strain == pytest.approx(0.25) and math.isnan(stop.stall.tangent_k_Nm_per_rad)
-    limit = large_deflection(_path(0.5, "limit_point"), 2.0, 11.7, 14.0, allowable_strain=0.433,
-                             contact_is_end_stop=True)
+    assert stop.stall.tensile_strain == pytest.approx(0.25) and math.isnan(stop.stall.tangent_k_Nm_per_rad)
+    limit = large_deflection(_path(0.5, "limit_point"), 2.0, 11.7, 14.0, LIMITS, contact_is_end_stop=True)
     assert not limit.stall.survives and math.isnan(limit.stall.rotation_rad)  # a torque maximum is no end stop
 
 
 def test_columns_keep_words_flags_and_curves():
-    ld = large_deflection(_path(0.5, "contact", n=3), 2.0, 11.7, 14.0, allowable_strain=None)
+    ld = large_deflection(_path(0.5, "contact", n=3), 2.0, 11.7, 14.0, StrainLimits(None, None))
     c = columns(ld, "large_")
     assert c["large_stop_reason"] == "contact" and c["large_stall_survives"] is False
     assert c["large_curve_rotation_rad"] == [0.0, 0.25, 0.5] and math.isnan(c["large_stall_strain_margin"])
-    assert c["large_standing_survives"] is True  # no allowable strain: nothing to fail
+    assert c["large_standing_survives"] is False  # no sourced limit: survival cannot be judged, so not claimed
+    assert c["large_curve_tangent_Nm_per_rad"][0] == pytest.approx(A / B)
 
 
 def test_torque_and_rotation_at_are_inverse_readings_of_the_curve():

@@ -69,17 +69,29 @@ def test_toml_syntax_error(tmp_path):
         load_material_file(_write(tmp_path, "name = "))
 
 
-def test_allowable_strain_and_the_derived_hyperelastic_law():
+def test_strain_limits_and_the_derived_hyperelastic_law():
     nf = load_material("ninjaflex")
     assert nf.elongation_at_yield == pytest.approx(0.65)
-    assert nf.allowable_strain(1.5) == pytest.approx(0.65 / 1.5)
-    assert load_material("cheetah").allowable_strain(1.5) is None  # no sourced value: cannot be judged
-    law = nf.law  # DOMAIN.md: E 12 MPa, nu 0.48 -> C10 = mu / 2 = 2.03 MPa, D1 = 2 / K = 0.020 1/MPa
+    assert nf.strain_limits(1.5).single == pytest.approx(0.65 / 1.5)
+    assert nf.strain_limits(1.5).cyclic is None  # no sourced cyclic limit: the repeating loads cannot be judged
+    assert load_material("cheetah").strain_limits(1.5).single is None  # no sourced value: cannot be judged
+    law = nf.law  # E 12 MPa, nu 0.48 -> C10 = mu / 2 = 2.03 MPa, D1 = 2 / K = 0.020 1/MPa
     assert law.model == "neo_hooke"
     assert law.c10_Pa == pytest.approx(12e6 / (2 * 1.48) / 2)
     assert law.d1_per_Pa == pytest.approx(2 / (12e6 / (3 * (1 - 0.96))))
     soft = nf.scaled(0.5, "test").law
     assert soft.c10_Pa == pytest.approx(law.c10_Pa / 2) and soft.d1_per_Pa == pytest.approx(law.d1_per_Pa * 2)
+
+
+def test_a_cyclic_strain_limit_is_read_and_must_stay_below_the_elongation_at_yield(tmp_path):
+    yield_65 = GOOD + 'elongation_at_yield = { value = 65.0, unit = "%", source = "test" }\n'
+    m = load_material_file(_write(tmp_path, yield_65 + 'cyclic_strain_limit = { value = 20.0, unit = "%", source = "t" }\n'))
+    assert m.cyclic_strain_limit == pytest.approx(0.2) and m.strain_limits(1.5).at("stall") == pytest.approx(0.2)
+    assert m.strain_limits(1.5).at("impact") == pytest.approx(0.65 / 1.5)
+    with pytest.raises(ConfigError, match=r"cyclic_strain_limit \(70 %\) must not exceed elongation_at_yield \(65 %\)"):
+        load_material_file(_write(tmp_path, yield_65 + 'cyclic_strain_limit = { value = 70.0, unit = "%", source = "t" }\n'))
+    with pytest.raises(ConfigError, match=r"cyclic_strain_limit \(20 %\) must not exceed elongation_at_yield \(not given\)"):
+        load_material_file(_write(tmp_path, GOOD + 'cyclic_strain_limit = { value = 20.0, unit = "%", source = "t" }\n'))
 
 
 def test_a_hyperelastic_table_is_read_in_si_and_checked(tmp_path):

@@ -1,6 +1,7 @@
-"""Ranking on a hand-made table of large-deflection curves: constraints, Pareto front, weighted score,
-the unscorable pool, explanation. Linear curves T = k theta give closed-form objectives (bearing arc
-r T / k, strike torque w sqrt(k J)); a tanh curve checks the stored-energy reading in closed form."""
+"""Ranking on a hand-made table of large-deflection curves (`helpers_curves`): requirements judged and met,
+conditional designs, the deciding objective, the Pareto front, the explanation. Linear curves T = k theta
+give closed-form requirements (sag T / k, natural frequency sqrt(k / J) / 2 pi, one sensor count k q, strike
+torque w sqrt(k J)); a tanh curve checks the stored-energy reading in closed form."""
 
 from __future__ import annotations
 
@@ -11,10 +12,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from helpers_curves import table, with_limits
+from seadesign.design.spring import TorqueCurve
 from seadesign.design.study import load_study
-from seadesign.sweep.rank import pareto_front, rank, strike_torque
-
-ALLOWABLE = 0.433
+from seadesign.sweep.handoff import curve_to_stop
+from seadesign.sweep.rank import pareto_front, rank
 
 
 def test_pareto_front_of_a_known_set():
@@ -23,111 +25,109 @@ def test_pareto_front_of_a_known_set():
     assert pareto_front(obj).tolist() == [True, True, True, False, False]
 
 
-def _row(study, i: int, name: str, k: float, strain_per_rad: float, stop_Nm: float | None = None) -> dict:
-    """A solved candidate whose curve is T = k theta up to the impact torque, or to contact at `stop_Nm`; the
-    peak strain grows as strain_per_rad * theta."""
-    lc, r = study.load_cases, study.bearing_radius_mm
-    reason = "target_reached" if stop_Nm is None else "contact"
-    stop = lc.impact_torque_Nm if stop_Nm is None else stop_Nm
-    row = {"candidate": name, "beam_count": i + 3, "beam_thickness_mm": 6.0, "status": "ok", "reason": "",
-           "row_key": f"{i:032x}", "k_Nm_per_rad": k, "large_curve_rotation_rad": list(np.linspace(0, stop / k, 9)),
-           "large_curve_torque_Nm": list(np.linspace(0, stop, 9)), "large_stop_reason": reason,
-           "large_stop_rotation_rad": stop / k, "large_stop_torque_Nm": stop, "large_allowable_strain": ALLOWABLE,
-           "large_strain_limit_rotation_rad": ALLOWABLE / strain_per_rad,
-           "large_strain_limit_torque_Nm": k * ALLOWABLE / strain_per_rad}
-    for case, torque in (("standing", study.robot.standing_knee_torque_Nm), ("stall", lc.stall_torque_Nm),
-                         ("impact", lc.impact_torque_Nm)):
-        theta = torque / k if torque <= stop else math.nan
-        row.update({f"large_{case}_rotation_rad": theta, f"large_{case}_peak_strain": strain_per_rad * theta})
-    row["large_stall_secant_k_Nm_per_rad"] = k
-    row["large_stall_bearing_displacement_mm"] = row["large_stall_rotation_rad"] * r
-    return row
-
-
-def _table(study, rows) -> pd.DataFrame:
-    t = pd.DataFrame([_row(study, i, *r) for i, r in enumerate(rows)])
-    invalid = {"candidate": "G", "beam_count": 10, "beam_thickness_mm": 8.0, "status": "invalid",
-               "reason": "beams touch", "row_key": "f" * 32}
-    return pd.concat([t, pd.DataFrame([invalid])], ignore_index=True)
-
-
-ROWS = [  # name, k (Nm/rad), strain per rad, contact torque (Nm)
-    ("A", 20.0, 0.2),
-    ("B", 30.0, 0.2),
-    ("C", 40.0, 0.2),
-    ("E", 60.0, 0.5),  # impact: 27.7 / 60 rad x 0.5 = 0.23 < 0.433; stall fine too -> feasible, stiffest
-    ("H", 50.0, 1.0),  # impact strain 0.55 > 0.433
-    ("F", 5.0, 0.01),  # too soft: sags standing
-    ("K", 25.0, 0.2, 6.0),  # contact at 6 Nm: carries neither stall nor impact
+ROWS = [  # name, k (Nm/rad), tensile strain per rad, stop torque (Nm; None: the impact torque), mass (g)
+    ("A", 20.0, 0.2, None, 30.0),  # stall strain 0.117 of 0.2 cyclic; impact 0.277 of 0.433: feasible, softest
+    ("B", 30.0, 0.2, None, 25.0),
+    ("C", 40.0, 0.2, None, 22.0),  # the lightest feasible
+    ("E", 60.0, 0.5, None, 40.0),  # one count 60 x 2 pi / 4096 = 0.092 Nm of 0.1: feasible, stiffest
+    ("T", 70.0, 0.2, None, 20.0),  # one count 0.107 Nm: too stiff for the sensor
+    ("H", 50.0, 1.0, None, 20.0),  # stall strain 0.234 > 0.2 cyclic, impact 0.554 > 0.433
+    ("F", 5.0, 0.01, None, 10.0),  # too soft: sags 23.7 deg standing, 3.56 Hz
+    ("K", 25.0, 0.2, 6.0, 20.0),  # contact at 6 Nm: carries neither stall nor impact
 ]
 
 
 @pytest.fixture(scope="module")
 def study():
-    return load_study()  # allowable strain 0.65 / 1.5; standing limit 10 deg
+    """The default study (sag 10 deg, one count 0.1 Nm, 5 Hz, strike 11.7 Nm; softest_k decides) with a cyclic
+    strain limit of 0.2 and NinjaFlex's elongation at yield 0.65 (single-event limit 0.65 / 1.5)."""
+    return with_limits(load_study(), 0.2)
 
 
-def test_constraints_front_and_score(study):
-    t, choice = rank(_table(study, ROWS), study)
+def test_requirements_front_and_the_softest_feasible_choice(study):
+    t, choice = rank(table(study, ROWS), study)
     by = t.set_index("candidate")
-    assert by.loc["H", "failed_constraints"] == "impact strain < 0.433"
-    assert "standing deflection" in by.loc["F", "failed_constraints"]
+    assert by.loc["H", "failed_constraints"] == ("stall tensile strain within the cyclic limit; impact tensile strain "
+                                                 "within the single-event limit")
+    assert by.loc["T", "failed_constraints"] == "one sensor count <= 0.1 Nm"
+    assert by.loc["F", "failed_constraints"] == "standing deflection <= 10 deg; natural frequency >= 5 Hz"
     assert by.loc["K", "failed_constraints"] == "carries the stall torque (11.7 Nm); carries the impact torque (27.7 Nm)"
     assert by.loc["G", "failed_constraints"] == "valid geometry"
     feasible = ["A", "B", "C", "E"]
-    assert by.loc[feasible, "feasible"].all() and not by.loc[["H", "F", "K", "G"], "feasible"].any()
-    k = np.array([20.0, 30.0, 40.0, 60.0])
-    # linear curves: every feasible k is on the front (arc ~ 1 / k, strike torque ~ sqrt(k))
-    assert by.loc[feasible, "pareto"].all()
-    omega = study.ranking.impact_speed_m_per_s / study.robot.lower_leg_m
-    strike = omega * np.sqrt(k * study.ranking.knee_inertia_kg_m2)
-    # PCHIP of a straight line is the line: stored energy exact, bisected to 1e-18 rad
-    assert by.loc[feasible, "impact_gearbox_torque_Nm"].to_numpy() == pytest.approx(strike, rel=1e-12)
-    arc = study.load_cases.stall_torque_Nm / k * study.bearing_radius_mm
-    acc, prot = (arc.max() - arc) / (arc.max() - arc.min()), (strike.max() - strike) / (strike.max() - strike.min())
-    expected = 0.5 * acc + 0.5 * prot
-    assert by.loc[feasible, "score"].to_numpy() == pytest.approx(expected, rel=1e-12)
-    best = feasible[int(np.argmax(expected))]
-    assert t.loc[choice.index, "candidate"] == best and choice.feasible
-    assert best in choice.explanation and "runner-up" in choice.explanation
+    assert by.loc[feasible, "feasible"].all() and not by.loc[["T", "H", "F", "K", "G"], "feasible"].any()
+    assert not by["conditional"].any()
+    assert t.loc[choice.index, "candidate"] == "A" and choice.feasible and not choice.conditional
+    assert t.loc[choice.runner_up, "candidate"] == "B"
+    assert by.loc[feasible, "rank"].tolist() == [1, 2, 3, 4]
+    assert "A meets every requirement" in choice.explanation and "Runner-up: B" in choice.explanation
+    # k and mass: C (40, 22 g) is dominated by nobody; A, B, C, E all trade k against mass except E (heavier, stiffer)
+    assert by.loc[["A", "B", "C"], "pareto"].all() and not by.loc["E", "pareto"]
+    # closed forms of a linear spring
+    J, w = study.ranking.knee_inertia_kg_m2, study.strike_speed_rad_per_s
+    assert by.loc["A", "impact_gearbox_torque_Nm"] == pytest.approx(w * math.sqrt(20.0 * J), rel=1e-12)
+    assert by.loc["F", "natural_frequency_Hz"] == pytest.approx(math.sqrt(5.0 / J) / (2 * math.pi), rel=1e-12)
+    assert by.loc["E", "torque_per_count_Nm"] == pytest.approx(60.0 * 2 * math.pi / 4096, rel=1e-12)
     assert by.loc["A", "standing_deflection_deg"] == pytest.approx(np.degrees(study.robot.standing_knee_torque_Nm / 20))
+    # the strain against each load's class: the cyclic limit crossed at 0.2 / 0.2 rad = 20 Nm for A; the impact's
+    # single-event limit (0.433 at 2.17 rad, 43 Nm) lies past the path: limit / strain at the load - 1
+    assert by.loc["A", "stall_strain_margin"] == pytest.approx(20.0 / 11.7 - 1, rel=1e-9)
+    assert by.loc["A", "impact_strain_margin"] == pytest.approx(0.65 / 1.5 / (0.2 * 27.7 / 20.0) - 1, rel=1e-3)
 
 
-def test_weights_move_the_choice(study):
-    accurate = dataclasses.replace(study, ranking=dataclasses.replace(study.ranking, weight_accuracy=1.0,
-                                                                      weight_protection=0.0))
-    protective = dataclasses.replace(study, ranking=dataclasses.replace(study.ranking, weight_accuracy=0.0,
-                                                                        weight_protection=1.0))
-    t, c = rank(_table(study, ROWS), accurate)
-    assert t.loc[c.index, "candidate"] == "E"  # stiffest feasible: smallest arc
-    t, c = rank(_table(study, ROWS), protective)
-    assert t.loc[c.index, "candidate"] == "A"  # softest feasible spring
+def test_the_deciding_objective_moves_the_choice(study):
+    def choose(*objectives):
+        s = dataclasses.replace(study, requirements=dataclasses.replace(study.requirements, objectives=objectives))
+        t, c = rank(table(study, ROWS), s)
+        return t.loc[c.index, "candidate"]
+
+    assert choose("mass") == "C"  # the lightest feasible
+    assert choose("accuracy") == "E"  # the stiffest feasible: the smallest arc at stall
+    assert choose("protection") == "A"  # the softest: strike torque w sqrt(k J)
+    assert choose("strain_margin") == "C"  # the smallest share of a limit used (0.2 x 27.7 / 40 of 0.433)
 
 
-def test_a_pool_that_stops_before_stall_is_ordered_by_the_usable_torque(study):
-    """Usable: the smaller of the stop torque and where the strain passes the allowable. S stops at 9 Nm but
-    passes the allowable at 0.433 / 3 rad x 30 Nm/rad = 4.33 Nm, below both loads: it misses the strain at
-    stall and impact too, so it fails four requirements and the others two."""
-    rows = [("P", 20.0, 0.2, 5.0), ("Q", 30.0, 0.2, 8.0), ("R", 25.0, 0.2, 7.0), ("S", 30.0, 3.0, 9.0)]
-    t, c = rank(_table(study, rows), study)
+def test_a_requirement_that_cannot_be_judged_is_not_met(study):
+    """Without a cyclic strain limit nothing is feasible: the designs that meet every judged requirement are
+    conditional, the choice among them says so, and names the value the missing datum must reach."""
+    unsourced = with_limits(study, None)
+    t, c = rank(table(unsourced, ROWS), unsourced)
     by = t.set_index("candidate")
-    assert by.loc["S", "usable_torque_Nm"] == pytest.approx(4.33) and by.loc["Q", "usable_torque_Nm"] == 8.0
-    assert by.loc["S", "failed_constraints"] == ("carries the stall torque (11.7 Nm); carries the impact torque "
-                                                 "(27.7 Nm); stall strain < 0.433; impact strain < 0.433")
-    # the margins: travel 9 / 11.7 - 1, strain 4.33 / 11.7 - 1 at stall (and / 27.7 at impact)
-    assert by.loc["S", "stall_travel_margin"] == pytest.approx(9 / 11.7 - 1)
-    assert by.loc["S", "stall_strain_margin"] == pytest.approx(4.33 / 11.7 - 1, rel=1e-3)
-    assert not c.feasible and t.loc[c.index, "candidate"] == "Q"
-    assert by.loc[["Q", "R", "P"], "rank"].tolist() == [1, 2, 3] and pd.isna(by.loc["S", "rank"])
-    assert t["score"].isna().all() and "most usable torque" in c.explanation and "8 Nm usable" in c.explanation
+    assert not t["feasible"].any()
+    assert by.loc[["A", "B", "C", "E"], "conditional"].all() and not by.loc[["T", "H", "F", "K"], "conditional"].any()
+    assert not c.feasible and c.conditional and t.loc[c.index, "candidate"] == "A"
+    # A's tensile strain at stall: 0.2 / rad x 11.7 / 20 rad = 11.7 %
+    assert "passes if NinjaFlex TPU 85A's cyclic strain limit is at least 11.7 %" in c.explanation
+    assert np.isnan(by.loc["A", "stall_strain_margin"])
+    no_yield = with_limits(study, 0.2, elongation=None)
+    t, c = rank(table(no_yield, ROWS), no_yield)
+    # A's impact strain 0.2 x 27.7 / 20 = 0.277, needing 0.277 x 1.5 = 41.5 % elongation at yield
+    assert c.conditional and "elongation at yield is at least 41.5 %" in t.loc[c.index, "not_judged"]
 
 
-def test_k_range_and_no_feasible_candidate(study):
-    narrow = dataclasses.replace(study, requirements=dataclasses.replace(study.requirements, k_min_Nm_per_rad=100.0))
-    t, c = rank(_table(study, ROWS), narrow)
-    assert not t["feasible"].any() and not c.feasible
-    assert "No candidate meets every hard constraint" in c.explanation
-    assert t.loc[c.index, "n_failed_constraints"] == t.loc[t["status"] == "ok", "n_failed_constraints"].min()
+def test_when_nothing_is_feasible_the_report_names_the_block(study):
+    rows = [("P", 20.0, 0.2, 5.0), ("Q", 30.0, 0.2, 8.0), ("R", 70.0, 0.2, 9.0)]
+    t, c = rank(table(study, rows), study)
+    by = t.set_index("candidate")
+    assert not c.feasible and not c.conditional
+    # P and Q miss the two loads; R misses the loads and the sensor: the fewest failures are P and Q, softest P
+    assert t.loc[c.index, "candidate"] == "P" and pd.isna(by.loc["R", "rank"])
+    assert "NOT a recommendation" in c.explanation
+    assert "carries the impact torque (27.7 Nm) (by 81.9 %)" in c.explanation  # 1 - 5 / 27.7
+    assert "contact carrying the load" in c.explanation
+
+
+def test_a_strike_the_curve_cannot_store_misses_protection(study):
+    """A stiff spring that stops at 0.1 Nm stores 0.1^2 / (2 k) J, far less than the strike's J w^2 / 2: the
+    strike margin is the stored energy's shortfall."""
+    t, _ = rank(table(study, [("S", 1000.0, 0.01, 0.1)], invalid=False), study)
+    energy = 0.5 * study.ranking.knee_inertia_kg_m2 * study.strike_speed_rad_per_s ** 2
+    assert np.isnan(t.loc[0, "impact_gearbox_torque_Nm"])
+    assert t.loc[0, "strike_margin"] == pytest.approx(0.1 ** 2 / 2000.0 / energy - 1, rel=1e-9)
+
+
+def strike_torque(row: pd.Series, energy_J: float) -> float:
+    torque = TorqueCurve(*map(tuple, curve_to_stop(row))).torque_at_energy(energy_J)
+    return math.nan if torque is None else torque
 
 
 def _path_row(theta: np.ndarray, torque: np.ndarray, stop_rad: float, stop_Nm: float) -> pd.Series:

@@ -3,8 +3,10 @@
 Each property is a table `{ value = ..., unit = "...", source = "..." }`; the loader converts
 to SI (Pa, kg/m^3, 1/Pa, strain as a fraction) and rejects anything missing, non-numeric or
 outside a physical range. Two optional entries serve the large-deflection analysis:
-`elongation_at_yield` (the allowable strain's basis, with its source; without it the strain
-requirement cannot be judged and results say so), and `hyperelastic`, the finite-strain law in
+`elongation_at_yield` (the single-event allowable strain's basis) and `cyclic_strain_limit` (the
+allowable tensile strain of loads repeated millions of times, at most the elongation at yield), each with
+its source; without one, the strain requirement of its load class cannot be judged and is not met (results
+say which datum is missing and what value would pass), and `hyperelastic`, the finite-strain law in
 CalculiX's form (`model = "neo_hooke" | "mooney_rivlin" | "yeoh"` with its constants and a
 source). Without `hyperelastic`, a neo-Hookean law is derived from E and nu (C10 = mu / 2,
 D1 = 2 / K), so the small-strain limit is exactly the linear model.
@@ -66,6 +68,20 @@ class Hyperelastic:
 
 
 @dataclass(frozen=True)
+class StrainLimits:
+    """The allowable tensile engineering strains of the two load classes (None: no sourced value, so the
+    strain there cannot be judged): repeating loads (standing, walking up to the stall torque) against the
+    material's cyclic strain limit, the single impact against elongation at yield / safety factor."""
+
+    cyclic: float | None
+    single: float | None
+
+    def at(self, load: str) -> float | None:
+        """The limit that applies to a load: the single-event one at impact, the cyclic one elsewhere."""
+        return self.single if load == "impact" else self.cyclic
+
+
+@dataclass(frozen=True)
 class Material:
     """An isotropic linear-elastic material in SI units."""
 
@@ -79,15 +95,18 @@ class Material:
     sources: tuple[tuple[str, str], ...]  # (property, source) pairs
     hyperelastic: Hyperelastic | None = None  # None: derived from E and nu (see `law`)
     elongation_at_yield: float | None = None  # engineering strain (0.65 = 65 %); None: no sourced value
+    cyclic_strain_limit: float | None = None  # tensile engineering strain for loads repeated millions of times
 
     @property
     def law(self) -> Hyperelastic:
         """The finite-strain law: the file's, or the neo-Hookean one derived from E and nu."""
         return self.hyperelastic or Hyperelastic.from_linear(self.youngs_modulus_Pa, self.poisson_ratio)
 
-    def allowable_strain(self, safety_factor: float) -> float | None:
-        """Allowable engineering strain: elongation at yield / safety factor (None when unsourced)."""
-        return None if self.elongation_at_yield is None else self.elongation_at_yield / safety_factor
+    def strain_limits(self, safety_factor: float) -> StrainLimits:
+        """The allowable tensile strains: the cyclic limit as sourced (no factor: the source's limit is already
+        one for repeated loading) and elongation at yield / safety factor for a single event; None unsourced."""
+        single = None if self.elongation_at_yield is None else self.elongation_at_yield / safety_factor
+        return StrainLimits(self.cyclic_strain_limit, single)
 
     @property
     def shear_modulus_Pa(self) -> float:
@@ -162,10 +181,17 @@ def load_material_file(path: str | Path) -> Material:
     for field, (units, (lo, hi)) in _FIELDS.items():
         values[field], src = _quantity(top, field, units, lo, hi)
         sources.append((field, src))
-    elongation = None
-    if "elongation_at_yield" in top.data:
-        elongation, src = _quantity(top, "elongation_at_yield", _STRAIN, 0.0, 20.0)
-        sources.append(("elongation_at_yield", src))
+    strains = {}
+    for field in ("elongation_at_yield", "cyclic_strain_limit"):
+        if field in top.data:
+            strains[field], src = _quantity(top, field, _STRAIN, 0.0, 20.0)
+            sources.append((field, src))
+    elongation, cyclic = strains.get("elongation_at_yield"), strains.get("cyclic_strain_limit")
+    if cyclic is not None and (elongation is None or cyclic > elongation):
+        raise top.error("cyclic_strain_limit", f"({100 * cyclic:.3g} %) must not exceed elongation_at_yield "
+                        + ("(not given)" if elongation is None else f"({100 * elongation:.3g} %)")
+                        + ": a limit for repeated loading lies below the single pull's yield; check both values "
+                          "and their sources")
     hyper = _hyperelastic(top)
     top.done()
     return Material(
@@ -179,6 +205,7 @@ def load_material_file(path: str | Path) -> Material:
         sources=tuple(sources),
         hyperelastic=hyper,
         elongation_at_yield=elongation,
+        cyclic_strain_limit=cyclic,
     )
 
 

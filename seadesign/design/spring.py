@@ -142,6 +142,11 @@ class TorqueCurve:
         """Initial stiffness dT/dtheta at 0 (Nm/rad)."""
         return float(self._pchip().derivative()(0.0))
 
+    @property
+    def energy_J(self) -> float:
+        """The energy (J) the whole curve stores when loaded from rest, int_0^end T dtheta."""
+        return float(self._pchip().antiderivative()(self.rotation_rad[-1]))
+
     def torque_at_energy(self, energy_J: float) -> float | None:
         """The torque (Nm) where the curve, loaded from rest, has stored `energy_J` (J): int_0^theta T dtheta
         = energy; None when the whole curve stores less (a load that reaches its end)."""

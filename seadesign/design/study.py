@@ -21,7 +21,7 @@ from seadesign.constants import G_M_PER_S2
 from seadesign.design.candidate import Candidate, check_candidate
 from seadesign.design.materials import Material, load_material
 from seadesign.design.params import ValidityRules, read_geometry
-from seadesign.design.requirements import Requirements, read_requirements
+from seadesign.design.requirements import KWindow, Requirements, check_window, k_window, read_requirements, refuse_moved_keys
 from seadesign.design.space import MATERIAL_KEY, Axis, Value, grid, merged, read_axes
 from seadesign.design.tomlcheck import Table, find_toml, read_toml
 from seadesign.errors import ConfigError
@@ -99,13 +99,11 @@ class MeshSettings:
 
 @dataclass(frozen=True)
 class Ranking:
-    """How a sweep scores candidates (the constraints are `Requirements`)."""
+    """The physical settings a sweep judges candidates with (the constraints and objectives are `Requirements`)."""
 
-    safety_factor: float  # the allowable strain is the elongation at yield / safety_factor
+    safety_factor: float  # the single-event allowable strain is the elongation at yield / safety_factor
     impact_speed_m_per_s: float  # foot speed at touchdown
     knee_inertia_kg_m2: float  # inertia of the link behind the spring, about the knee
-    weight_accuracy: float
-    weight_protection: float
     contact_is_end_stop: bool = False  # contact closing a gap may carry torque past it (else: contact ends the travel)
 
 
@@ -125,6 +123,19 @@ class Study:
     ranking: Ranking
     bearing_radius_mm: float  # where the stall displacement is read (thesis eq. 5.3)
     requirements: Requirements
+
+    @property
+    def strike_speed_rad_per_s(self) -> float:
+        """The lower leg's angular speed about the knee at touchdown (rad/s): foot speed / lower leg."""
+        return self.ranking.impact_speed_m_per_s / self.robot.lower_leg_m
+
+    @property
+    def k_window(self) -> KWindow:
+        """The stiffness window the requirements imply on the study's own numbers (`design.requirements`)."""
+        return k_window(self.requirements, standing_torque_Nm=self.robot.standing_knee_torque_Nm,
+                        stall_torque_Nm=self.load_cases.stall_torque_Nm, lower_leg_m=self.robot.lower_leg_m,
+                        knee_inertia_kg_m2=self.ranking.knee_inertia_kg_m2,
+                        strike_speed_rad_per_s=self.strike_speed_rad_per_s)
 
     @property
     def material(self) -> Material:
@@ -257,7 +268,7 @@ def _mesh(top: Table) -> MeshSettings:
 
 
 def _ranking(top: Table) -> tuple[Ranking, Requirements]:
-    """[ranking] and the requirements it holds with [requirements] (see design/requirements.py)."""
+    """[ranking] and [requirements] (see design/requirements.py)."""
     rk = top.table("ranking")
     if rk.raw("small_deflection_limit_rad") is not None:
         raise rk.error(rk.key("small_deflection_limit_rad"), "is no longer used: the large-deflection path replaced the "
@@ -266,15 +277,11 @@ def _ranking(top: Table) -> tuple[Ranking, Requirements]:
         safety_factor=rk.number("safety_factor", ge=1),
         impact_speed_m_per_s=rk.number("impact_speed_m_per_s", gt=0),
         knee_inertia_kg_m2=rk.number("knee_inertia_kg_m2", gt=0),
-        weight_accuracy=rk.number("weight_accuracy", ge=0),
-        weight_protection=rk.number("weight_protection", ge=0),
         contact_is_end_stop=rk.boolean("contact_is_end_stop", False),
     )
-    requirements = read_requirements(rk, top.table("requirements", optional=True))
+    refuse_moved_keys(rk)
     rk.done()
-    if ranking.weight_accuracy + ranking.weight_protection <= 0:
-        raise ConfigError(f"{top.file}: ranking.weight_accuracy + ranking.weight_protection must be > 0")
-    return ranking, requirements
+    return ranking, read_requirements(top.table("requirements", optional=True))
 
 
 def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
@@ -293,6 +300,7 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     study = Study(name, description, path, _materials(top, axes), axes, fixed, _validity(top),
                   _load_cases(top, robot), robot, _actuator(top), _mesh(top), ranking, bearing_radius_mm, requirements)
     top.done()
+    check_window(study.k_window, str(path))
     if all(not a.continuous for a in axes):
         study.candidates()  # every combination is checked now, so a bad value is named before any work starts
     else:

@@ -147,6 +147,10 @@ class Table:
         """Reject unknown keys (typos must not be silently ignored)."""
         unknown = sorted(set(self.data) - self.seen)
         if unknown:
+            with_unit = [k for k in sorted(self.seen) if k.startswith(unknown[0] + "_")]
+            if with_unit:
+                raise self.error(self.key(unknown[0]), f"has no unit in its name; write {self.key(with_unit[0])} "
+                                                       "(the key says the value's unit)")
             known = ", ".join(sorted(self.seen))
             raise self.error(self.key(unknown[0]), f"is not a known key; known keys here: {known}")
 

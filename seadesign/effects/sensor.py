@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from seadesign.constants import AS5600_BITS
 from seadesign.effects.base import Effect, Param, Scales, Search, lowpass
 
 
@@ -148,7 +149,7 @@ class Quantisation(Effect):
 
     key = "quantisation"
     summary = "reading = round(value / q) q, q = 2 pi / 2^bits"
-    parameters = (Param("bits", "bit", 12.0, 1.0, 32.0, "encoder resolution n per revolution"),)
+    parameters = (Param("bits", "bit", float(AS5600_BITS), 1.0, 32.0, "encoder resolution n per revolution"),)
     writes = "hall"
 
     def _map(self, x, p, rng):

@@ -23,6 +23,10 @@ from seadesign.fea.hyperelastic import det_and_inverse_transpose, i1_tangent, is
 from seadesign.fea.kernels import add_element_vectors, contract, deformation_gradients, general_pair_blocks, i1_pair_blocks
 
 _CHUNK = 4096  # elements per vectorised block
+# A principal direction is tensile (compressive) when its Cauchy stress is above (below) this fraction of the
+# point's largest principal stress magnitude: a free face of a squeezed region carries only the
+# discretisation's noise along its normal, which must not turn the region's bulge into a tensile strain.
+TENSION_FLOOR = 0.01
 FORMULATIONS = ("full", "mean_dilatation")
 
 
@@ -145,21 +149,49 @@ class Solid:
             add_element_vectors(f, self.mesh.elements[el], np.einsum("abmik,mbk->mai", k, v_m[self.mesh.elements[el]]))
         return f
 
-    def element_strain_stress(self, u_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Per element, the largest over its quadrature points of the principal stretch (max eigenvalue
-        of U = sqrt(F^T F), so engineering strain = stretch - 1, logarithmic = ln stretch) and of the Cauchy
-        von Mises stress (Pa) of sigma = P F^T / J; both (m,)."""
+    def element_strain_stress(self, u_m: np.ndarray) -> ElementStrainStress:
+        """Per element, the largest over its quadrature points of the tensile and the compressive principal
+        engineering strain (`principal_strains`) and of the Cauchy von Mises stress (Pa)."""
         m = len(self.mesh.elements)
-        stretch, mises = np.empty(m), np.empty(m)
+        tensile, compressive, mises = np.empty(m), np.empty(m), np.empty(m)
         for s in _chunks(m):
             F = self.deformation_gradient(u_m, s)
-            stretch[s] = np.sqrt(np.linalg.eigvalsh(np.swapaxes(F, -1, -2) @ F)[..., -1].max(axis=1))
             md = self._mean_dilatation(F, self.weights_m3[s])
             sig = stress(self.law, F, None if md is None else md[0]) @ np.swapaxes(F, -1, -2)
             sig /= det_and_inverse_transpose(F)[0][..., None, None]
+            t, c = principal_strains(F, sig)
+            tensile[s], compressive[s] = t.max(axis=1), c.max(axis=1)
             dev = sig - np.trace(sig, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) / 3
             mises[s] = np.sqrt(1.5 * np.einsum("...ij,...ij->...", dev, dev)).max(axis=1)
-        return stretch, mises
+        return ElementStrainStress(tensile, compressive, mises)
+
+
+@dataclass(frozen=True)
+class ElementStrainStress:
+    """Per element (m,): the largest tensile and compressive principal engineering strain and the Cauchy von
+    Mises stress (Pa) over its quadrature points."""
+
+    tensile_strain: np.ndarray
+    compressive_strain: np.ndarray
+    von_mises_Pa: np.ndarray
+
+
+def principal_strains(F: np.ndarray, sigma_Pa: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The tensile and the compressive principal engineering strain at each point (..., 3, 3 -> ...).
+
+    The principal stretches lambda_i and spatial directions n_i are the eigen-pairs of b = F F^T; in an
+    isotropic law the Cauchy stress sigma is coaxial with b, so n_i sigma n_i is the principal stress along
+    n_i. A direction is tensile where that stress exceeds `TENSION_FLOOR` times the point's largest principal
+    stress magnitude, compressive where it is below minus that. Tensile strain: the largest lambda_i - 1 along
+    a tensile direction; compressive: the largest 1 - lambda_i along a compressive one (0 where none). A
+    squeezed region's bulge (stretched, but free or confined) is not a tensile fibre and does not count."""
+    lam2, n = np.linalg.eigh(F @ np.swapaxes(F, -1, -2))
+    stretch = np.sqrt(np.clip(lam2, 0.0, None))
+    principal = np.einsum("...ji,...jk,...ki->...i", n, sigma_Pa, n)
+    floor = TENSION_FLOOR * np.abs(principal).max(axis=-1, keepdims=True)
+    tensile = np.where(principal > floor, stretch - 1.0, 0.0).max(axis=-1)
+    compressive = np.where(principal < -floor, 1.0 - stretch, 0.0).max(axis=-1)
+    return np.maximum(tensile, 0.0), np.maximum(compressive, 0.0)
 
 
 def _chunks(m: int) -> list[slice]:

@@ -17,7 +17,7 @@ The path stops, and says why (`STOP_REASONS` of `design.spring`):
 - contact: two facing surfaces (outward normals opposed by more than 120 degrees) come closer
   than `contact_gap_mm` (the notch beside a beam's root closing, a beam reaching its neighbour);
   the model has no contact forces, so the path ends there, interpolated to the tolerance;
-- strain_limit: the peak principal engineering strain passed the allowable strain;
+- strain_limit: the peak tensile principal engineering strain passed the allowable strain;
 - rotation_limit: the rotation reached `max_rotation_rad` below the target torque;
 - unconverged: the increment fell below `min_step_rad` without convergence (never a capacity).
 SI units throughout; mesh coordinates arrive in mm.
@@ -66,11 +66,13 @@ class PathPoint:
     rotation_rad: float
     torque_Nm: float
     tangent_Nm_per_rad: float  # dT/dtheta
-    peak_strain: float  # largest principal engineering strain (max stretch - 1) at the quadrature points
+    peak_tensile_strain: float  # largest tensile principal engineering strain at the quadrature points (Solid.element_strain_stress)
     min_gap_mm: float  # smallest gap between facing surfaces (mm; inf: none within the search distance)
     iterations: int
     residual_norms_N: tuple[float, ...]
-    peak_strain_element: int = -1  # element of the peak strain
+    peak_tensile_element: int = -1  # element of the peak tensile strain
+    peak_compressive_strain: float = 0.0  # largest compressive principal engineering strain (1 - stretch)
+    peak_compressive_element: int = -1
     peak_von_mises_Pa: float = 0.0  # largest Cauchy von Mises stress at the quadrature points
     peak_von_mises_element: int = -1
     min_gap_at_mm: tuple[float, float, float] = (float("nan"),) * 3  # where the smallest gap is (at rest)
@@ -329,11 +331,11 @@ def _state(p: _Problem, u: np.ndarray, f: np.ndarray, theta: float, iterations: 
     df = p.solid.tangent_product(u, v, rows=p.hub)  # dT/dtheta needs the hub's rows only
     xd = p.solid.mesh.nodes_m[p.hub] + u[p.hub]
     dT = moment_z(v[p.hub], f[p.hub]) + moment_z(xd, df[p.hub])
-    stretch, mises = p.solid.element_strain_stress(u)
-    i, j = int(np.argmax(stretch)), int(np.argmax(mises))
+    strain = p.solid.element_strain_stress(u)
+    i, j, c = (int(np.argmax(x)) for x in (strain.tensile_strain, strain.von_mises_Pa, strain.compressive_strain))
     gap, gap_at = _min_gap_mm(p, u)
-    point = PathPoint(theta, p.torque(u, f), dT, float(stretch[i]) - 1.0, gap, iterations, tuple(norms),
-                      i, float(mises[j]), j, gap_at)
+    point = PathPoint(theta, p.torque(u, f), dT, float(strain.tensile_strain[i]), gap, iterations, tuple(norms),
+                      i, float(strain.compressive_strain[c]), c, float(strain.von_mises_Pa[j]), j, gap_at)
     return point, v
 
 
@@ -375,7 +377,7 @@ def _stop_check(p: _Problem, prev: PathPoint, point: PathPoint, target_Nm: float
         return "limit_point"
     if point.min_gap_mm < s.contact_gap_mm:
         return "contact"
-    if s.allowable_strain is not None and point.peak_strain > s.allowable_strain:
+    if s.allowable_strain is not None and point.peak_tensile_strain > s.allowable_strain:
         return "strain_limit"
     if point.torque_Nm >= target_Nm:
         return "target_reached"

@@ -110,7 +110,7 @@ def write_renders(study: Study, row: pd.Series, folder: Path, solver: SolverSett
     key = digest("render", key_path, title, code_fingerprint("seadesign.report.renders"))
     if not up_to_date([path], key):
         response = cache.get("path", key_path)
-        if response is None or render_path(response, float(row["large_allowable_strain"]), title, path) is None:
+        if response is None or render_path(response, float(row["large_stall_strain_limit"]), title, path) is None:
             return {}
         stamp([path], key)
     return {f"Chosen part {where}, true scale (colour: largest principal strain, %)": path}

@@ -12,10 +12,11 @@ COLOUR_PERCENTILE = 99.0  # the colour scale ends at this percentile of the vert
 # otherwise squeeze the rest of the part into one colour); above it: red
 
 
-def render_path(path_response, allowable_strain: float, title: str, path: Path) -> Path | None:
-    """PNG of the path's snapshot state (`sweep.path_stage.PathResponse`) at true scale, coloured by the
-    largest principal engineering strain (%) up to its 99th percentile (red above; the allowable strain and the
-    peak in the caption); None (with a logged message) when off-screen rendering is unavailable."""
+def render_path(path_response, strain_limit: float, title: str, path: Path) -> Path | None:
+    """PNG of the path's snapshot state (`sweep.path_stage.PathResponse`, at the stall torque) at true scale,
+    coloured by the largest tensile principal engineering strain (%) up to its 99th percentile (red above; the
+    stall's strain limit and the peak in the caption); None (with a logged message) when off-screen rendering
+    is unavailable."""
     try:
         import pyvista as pv
 
@@ -25,12 +26,12 @@ def render_path(path_response, allowable_strain: float, title: str, path: Path) 
         grid = pv.UnstructuredGrid(cells, np.full(len(r.tets), pv.CellType.TETRA, dtype=np.uint8),
                                    r.points_mm + r.vertex_displacement_m * 1e3)
         strain = r.vertex_strain * 100.0
-        grid.point_data["principal strain (%)"] = strain
+        grid.point_data["tensile strain (%)"] = strain
         top = float(np.percentile(strain, COLOUR_PERCENTILE))
         plotter = pv.Plotter(off_screen=True, window_size=(900, 700))
-        plotter.add_mesh(grid.extract_surface(algorithm=None), scalars="principal strain (%)", cmap="viridis",
+        plotter.add_mesh(grid.extract_surface(algorithm=None), scalars="tensile strain (%)", cmap="viridis",
                          clim=(0.0, top), above_color="red", show_edges=False)
-        allowed = "" if not np.isfinite(allowable_strain) else f"; allowable {100 * allowable_strain:.3g} %"
+        allowed = "" if not np.isfinite(strain_limit) else f"; cyclic limit {100 * strain_limit:.3g} %"
         plotter.add_text(f"{title}\n{r.snapshot_rotation_rad:.3g} rad, {r.snapshot_torque_Nm:.3g} Nm, true scale; red: "
                          f"strain above {top:.3g} % (peak {float(strain.max()):.3g} %{allowed})", font_size=10)
         plotter.view_xy()

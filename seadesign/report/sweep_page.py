@@ -14,22 +14,28 @@ RANKED_SHOWN = 10  # candidates in the compact table
 
 
 def large_deflection_summary(t: pd.DataFrame) -> str:
-    """How the solved candidates' torque paths went, in words: where they stop and why, and the strain limit."""
+    """How the solved candidates' torque paths went, in words: where they stop and why, and the strain limits."""
     solved = t[t["status"] == "ok"]
     if solved.empty or "large_stop_reason" not in solved:
         return "No candidate was solved."
     stops = solved["large_stop_reason"].value_counts()
-    allowable = solved["large_allowable_strain"].dropna()
     text = ("Each solved candidate's hub is rotated (hyperelastic finite-strain FEA, hub held as the servo holds it) "
             "until the impact torque or a stop. Stops: " + ", ".join(f"{r}: {n}" for r, n in stops.items()) + ". "
             f"{int(solved['large_stall_survives'].astype(bool).sum())} of {len(solved)} carry the stall torque within "
-            f"the allowable strain; {int(solved['large_impact_survives'].astype(bool).sum())} the impact torque. Torque "
-            f"carried before the path stops: {solved['large_stop_torque_Nm'].min():.3g}-"
-            f"{solved['large_stop_torque_Nm'].max():.3g} Nm.")
-    if not allowable.empty:
-        passed = solved["large_strain_limit_torque_Nm"].dropna()
-        text += (f" Allowable strain {allowable.iloc[0]:.3g} (elongation at yield / safety factor): passed by "
-                 f"{len(passed)} candidates" + (f", at {passed.min():.3g}-{passed.max():.3g} Nm." if len(passed) else "."))
+            f"the cyclic strain limit; {int(solved['large_impact_survives'].astype(bool).sum())} the impact torque "
+            f"within the single-event limit. Torque carried before the path stops: "
+            f"{solved['large_stop_torque_Nm'].min():.3g}-{solved['large_stop_torque_Nm'].max():.3g} Nm. Strains are "
+            "tensile principal strains (along directions of tensile principal stress); a squeezed region's bulge "
+            "is reported as compression beside them.")
+    for kind, words in (("cyclic", "cyclic strain limit (repeating loads)"),
+                        ("single", "single-event strain limit (elongation at yield / safety factor)")):
+        limit = solved[f"large_{kind}_strain_limit"].dropna()
+        if limit.empty:
+            text += f" No sourced {words}: not judged, so not met."
+            continue
+        passed = solved[f"large_{kind}_limit_torque_Nm"].dropna()
+        text += (f" {words[0].upper() + words[1:]} {limit.iloc[0]:.3g}: passed by {len(passed)} candidates"
+                 + (f", at {passed.min():.3g}-{passed.max():.3g} Nm." if len(passed) else "."))
     return text
 
 

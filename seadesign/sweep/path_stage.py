@@ -4,7 +4,7 @@ The path (`fea.rotation_path`, the material's hyperelastic law) runs from rest t
 torque or to where it stops, on the result mesh's in-plane sizing with `SolverSettings.path_layers`
 layers through the thickness (its error against the result mesh is in the README's table). `fea.large_deflection`
 reads it at the standing, stall and impact torques. The result is cached under the mesh, the law,
-the path settings, the torques, the allowable strain, the end-stop rule and the code.
+the path settings, the torques, the strain limits, the end-stop rule and the code.
 """
 
 from __future__ import annotations
@@ -36,18 +36,18 @@ class PathResponse:
     points_mm: np.ndarray  # (n, 3) vertices of the path mesh
     tets: np.ndarray  # (m, 4)
     vertex_displacement_m: np.ndarray  # (n, 3) at the snapshot
-    vertex_strain: np.ndarray  # (n,) largest principal engineering strain of the elements at each vertex
+    vertex_strain: np.ndarray  # (n,) largest tensile principal engineering strain of the elements at each vertex
     snapshot_rotation_rad: float
     snapshot_torque_Nm: float
 
 
 def path_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
-    """Inputs of the path: the mesh, the law, the path's mesh and settings, the torques, the allowable strain,
+    """Inputs of the path: the mesh, the law, the path's mesh and settings, the torques, the strain limits,
     the end-stop rule and the code of this module with everything it imports."""
     lc = study.load_cases
     return digest("path", mesh_key(study, candidate), candidate.material.law, settings.path_layers,
                   settings.path_formulation, PathSettings(), study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm,
-                  lc.impact_torque_Nm, candidate.material.allowable_strain(study.ranking.safety_factor),
+                  lc.impact_torque_Nm, candidate.material.strain_limits(study.ranking.safety_factor),
                   study.ranking.contact_is_end_stop, code_fingerprint(__name__), package_versions())
 
 
@@ -65,12 +65,12 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     path = rotation_path(mesh, m.law, lc.impact_torque_Nm, PathSettings(), order=settings.element_order,
                          formulation=settings.path_formulation, snapshot_torque_Nm=lc.stall_torque_Nm)
     result = large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
-                              m.allowable_strain(study.ranking.safety_factor), study.ranking.contact_is_end_stop)
-    stretch = Solid.of(path.emesh, m.law, settings.path_formulation).element_strain_stress(
-        path.snapshot_displacement_m)[0]
+                              m.strain_limits(study.ranking.safety_factor), study.ranking.contact_is_end_stop)
+    tensile = Solid.of(path.emesh, m.law, settings.path_formulation).element_strain_stress(
+        path.snapshot_displacement_m).tensile_strain
     nv = len(mesh.points_mm)
     vertex_strain = np.zeros(nv)
-    np.maximum.at(vertex_strain, mesh.tets, (stretch - 1.0)[:, None])
+    np.maximum.at(vertex_strain, mesh.tets, tensile[:, None])
     shot = path.points[path.snapshot_index]
     response = PathResponse(result, mesh.points_mm, mesh.tets, path.snapshot_displacement_m[:nv], vertex_strain,
                             shot.rotation_rad, shot.torque_Nm)

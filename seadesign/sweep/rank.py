@@ -1,31 +1,32 @@
-"""Choose a candidate: hard constraints, physical objectives, Pareto front and weighted score.
+"""Choose a candidate: requirements judged and met, the deciding objective, the Pareto front.
 
 Everything is read from the large-deflection path (`large_` columns, `fea.large_deflection`), not
 from the linear model, which is far outside its range at these loads; the linear results stay in
 the table for comparison with the thesis.
 
-Objectives (both minimised):
-- accuracy: `large_stall_bearing_displacement_mm`, the arc the bearing circle turns through at the
-  stall torque;
-- gearbox protection: `impact_gearbox_torque_Nm`, the peak torque a foot strike drives into the
-  gearbox. The leg (inertia J about the knee, angular speed w = v / lower_leg at touchdown) is
-  stopped by the spring with the gearbox side held: its kinetic energy J w^2 / 2 goes into the
-  spring, int_0^theta T dtheta, and the torque where the curve has stored it is the peak. (A linear
-  spring gives tau_peak = w sqrt(k J).) A curve that ends before it has stored that energy gives
-  no number: the strike reaches the path's stop. A static reaction force cannot measure protection:
-  in statics the whole applied torque reaches the motor whatever k is (the thesis's 149-150 N for
-  every design).
+Objectives (all minimised; `sweep/requirements.py: OBJECTIVE_COLUMNS`): mass; accuracy, the arc the bearing
+circle turns through at the stall torque; gearbox protection, the peak torque a foot strike drives into the
+gearbox; strain_margin, the largest share of a load's strain limit used; softest_k, the small-load k. The
+first objective of `[requirements] objectives` decides among feasible designs, mass breaks ties.
 
-Hard constraints: valid geometry; solved; the path carries the stall and the impact torque (a stop
-before it, contact unless the study makes contact an end stop, a limit point or a buckling mode, fails
-the load); the peak strain at each load within the allowable strain (elongation at yield / safety
-factor); the standing deflection read from the curve; the study's k range (small-load k).
+Protection: the leg (inertia J about the knee, angular speed w = v / lower_leg at touchdown) is
+stopped by the spring with the gearbox side held: its kinetic energy J w^2 / 2 goes into the
+spring, int_0^theta T dtheta, and the torque where the curve has stored it is the peak. (A linear
+spring gives tau_peak = w sqrt(k J).) A curve that ends before it has stored that energy gives
+no number: the strike reaches the path's stop. A static reaction force cannot measure protection:
+in statics the whole applied torque reaches the motor whatever k is (the thesis's 149-150 N for
+every design).
+
+Feasible: valid geometry, solved, and every requirement judged and met. A design that meets every judged
+requirement but has some that cannot be judged (a strain limit the material file does not source) is
+conditional: never the choice while a feasible one exists, and reported with the value each missing datum
+must reach.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
@@ -34,8 +35,8 @@ from seadesign.constants import THESIS_FEA_RESULTS
 from seadesign.design.spring import TorqueCurve
 from seadesign.design.study import Study
 from seadesign.sweep.handoff import curve_to_stop
-# USABLE orders a pool that no objective can rank: the most usable torque first
-from seadesign.sweep.requirements import ACCURACY, PROTECTION, USABLE, margins, requirement_list, total_violation
+from seadesign.sweep.requirements import (OBJECTIVE_COLUMNS, OBJECTIVE_WORDS, PROTECTION, STRAIN_USE, USABLE, margins,
+                                          not_judged, requirement_list, strain_use, total_violation, working_range)
 
 
 @dataclass(frozen=True)
@@ -44,8 +45,9 @@ class Choice:
 
     index: int | None  # None when no candidate has FEA results
     runner_up: int | None
-    feasible: bool  # whether the chosen candidate meets every hard constraint
+    feasible: bool  # whether the chosen candidate meets every requirement, each judged
     explanation: str
+    conditional: bool = False  # chosen among designs that meet every judged requirement, some not judged
 
 
 def pareto_front(objectives: np.ndarray) -> np.ndarray:
@@ -58,31 +60,38 @@ def pareto_front(objectives: np.ndarray) -> np.ndarray:
     return mask
 
 
-def strike_torque(row: pd.Series, energy_J: float) -> float:
-    """The torque (Nm) where the row's curve, up to where its path stops, has stored `energy_J` (J); NaN when
-    it stores less."""
-    torque = TorqueCurve(*map(tuple, curve_to_stop(row))).torque_at_energy(energy_J)
-    return math.nan if torque is None else torque
-
-
 def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
-    """Standing deflection, impact energy and gearbox strike torque read from each curve, the usable torque
-    (the smaller of where the path stops and where the peak strain passes the allowable), thesis numbers."""
+    """Standing deflection, foot error at stall, impact energy, gearbox strike torque and the energy the curve
+    stores to its stop, the working range's tangents, natural frequency and torque per sensor count, the
+    usable torque (the smaller of where the path stops and where the tensile strain passes the cyclic limit),
+    the share of the strain limits used, thesis numbers."""
     rk, robot = study.ranking, study.robot
     t = table.copy()
-    energy = 0.5 * rk.knee_inertia_kg_m2 * (rk.impact_speed_m_per_s / robot.lower_leg_m) ** 2
+    energy = 0.5 * rk.knee_inertia_kg_m2 * study.strike_speed_rad_per_s ** 2
     solved = t["status"] == "ok"
     t["standing_knee_torque_Nm"] = robot.standing_knee_torque_Nm
     t["standing_deflection_deg"] = np.degrees(t["large_standing_rotation_rad"]) if "large_standing_rotation_rad" in t \
         else np.nan
+    t["stall_foot_error_mm"] = t["large_stall_rotation_rad"] * robot.lower_leg_m * 1e3 if "large_stall_rotation_rad" \
+        in t else np.nan
     t["strike_energy_J"] = energy
     if "large_stop_torque_Nm" in t:
-        t[USABLE] = t[["large_stop_torque_Nm", "large_strain_limit_torque_Nm"]].min(axis=1, skipna=True)
-    t[PROTECTION] = [strike_torque(r, energy) if ok else np.nan for ok, (_, r) in zip(solved, t.iterrows())]
+        t[USABLE] = t[["large_stop_torque_Nm", "large_cyclic_limit_torque_Nm"]].min(axis=1, skipna=True)
+    curves = [TorqueCurve(*map(tuple, curve_to_stop(r))) if ok else None for ok, (_, r) in zip(solved, t.iterrows())]
+    t["large_stop_energy_J"] = [np.nan if c is None else c.energy_J for c in curves]
+    t[PROTECTION] = [np.nan if c is None else _nan(c.torque_at_energy(energy)) for c in curves]
+    t = pd.concat([t.drop(columns=[c for c in ("working_min_tangent_k_Nm_per_rad", "working_max_tangent_k_Nm_per_rad",
+                                               "natural_frequency_Hz", "torque_per_count_Nm") if c in t]),
+                   working_range(t, study)], axis=1)
+    t[STRAIN_USE] = strain_use(t, study)
     thesis = [_thesis_result(study, row) for _, row in t.iterrows()]
     t["thesis_reaction_N"] = [r for r, _ in thesis]
     t["thesis_displacement_mm"] = [d for _, d in thesis]
     return t
+
+
+def _nan(value: float | None) -> float:
+    return math.nan if value is None else value
 
 
 def _thesis_result(study: Study, row: pd.Series) -> tuple[float, float]:
@@ -93,105 +102,116 @@ def _thesis_result(study: Study, row: pd.Series) -> tuple[float, float]:
 
 def constraint_columns(t: pd.DataFrame, study: Study) -> pd.DataFrame:
     """The requirement margins (`sweep/requirements.py`), `total_violation`, `failed_constraints` in words,
-    their count and `feasible`. An invalid design fails only "valid geometry", one that failed to solve only
-    "solved"; a requirement that cannot be judged is not counted as failed."""
+    their count, `not_judged` (the missing data and the values that would pass), `feasible` (every requirement
+    judged and met) and `conditional` (every judged requirement met, some not judged). An invalid design fails
+    only "valid geometry", one that failed to solve only "solved"."""
     m = margins(t, study)
     fails = pd.DataFrame({"valid geometry": t["status"] == "invalid", "solved": t["status"] == "failed"})
     for r in requirement_list(study):
         fails[r.words] = m[r.column] < 0
     t = pd.concat([t.drop(columns=[c for c in m.columns if c in t]), m], axis=1)
-    t["total_violation"] = total_violation(m).where(t["status"] == "ok", np.inf)
+    solved = t["status"] == "ok"
+    t["total_violation"] = total_violation(m).where(solved, np.inf)
     t["failed_constraints"] = ["; ".join(c for c in fails.columns if row[c]) for _, row in fails.iterrows()]
     t["n_failed_constraints"] = fails.sum(axis=1).astype(int)
-    t["feasible"] = t["n_failed_constraints"] == 0
+    t["not_judged"] = not_judged(t, study)
+    unjudged = m.isna().any(axis=1) if len(m.columns) else pd.Series(False, index=t.index)
+    t["feasible"] = solved & (t["n_failed_constraints"] == 0) & ~unjudged
+    t["conditional"] = solved & (t["n_failed_constraints"] == 0) & unjudged
     return t
 
 
-def _normalised(values: pd.Series) -> pd.Series:
-    """1 for the best (smallest) value, 0 for the worst; 1 everywhere when all are equal."""
-    lo, hi = values.min(), values.max()
-    return pd.Series(1.0, index=values.index) if hi == lo else (hi - values) / (hi - lo)
-
-
 def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
-    """Add physical, constraint, Pareto and score columns and choose a candidate.
+    """Add physical, constraint and Pareto columns and choose a candidate.
 
-    The pool is the feasible candidates; when none is feasible, the solved candidates that fail the
-    fewest constraints (the choice is then marked infeasible and says what it violates). A pool in which
-    some candidate has no objective (its curve stops before the stall torque or before storing the
-    strike's energy) cannot be scored: it is ordered by the usable torque, the most a candidate carries
-    before its path stops and within the allowable strain.
+    The pool is the feasible candidates; when none is, the conditional ones (every judged requirement met);
+    when none is, the solved candidates that fail the fewest requirements (the choice is then marked
+    infeasible and says what it misses). The pool is ordered by the deciding objective (the first of
+    `[requirements] objectives`), mass breaking ties; a design without that objective (its curve stops before
+    the stall torque or before storing the strike's energy) comes after, by the usable torque. The Pareto
+    front is over all objectives, among the pool's designs that have them all.
     """
     t = constraint_columns(physical_columns(table, study), study)
-    rk = study.ranking
     solved = t["status"] == "ok"
     t["pareto"] = False
-    t["accuracy_score"] = np.nan
-    t["protection_score"] = np.nan
-    t["score"] = np.nan
     t["rank"] = pd.array([pd.NA] * len(t), dtype="Int64")
     if not solved.any():
         return t, Choice(None, None, False, "No candidate was solved, so none can be chosen; see the reasons column.")
-    feasible = t["feasible"]
-    pool = feasible if feasible.any() else solved & (t["n_failed_constraints"] == t.loc[solved, "n_failed_constraints"].min())
+    feasible, conditional = t["feasible"], t["conditional"]
+    pool = feasible if feasible.any() else conditional if conditional.any() else \
+        solved & (t["n_failed_constraints"] == t.loc[solved, "n_failed_constraints"].min())
+    columns = [OBJECTIVE_COLUMNS[o] for o in study.requirements.objectives]
     p = t[pool]
-    scored = bool(p[[ACCURACY, PROTECTION]].notna().all(axis=None))
-    if scored:
-        t.loc[pool, "pareto"] = pareto_front(p[[ACCURACY, PROTECTION]].to_numpy())
-        acc, prot = _normalised(p[ACCURACY]), _normalised(p[PROTECTION])
-        w = rk.weight_accuracy + rk.weight_protection
-        t.loc[pool, "accuracy_score"] = acc
-        t.loc[pool, "protection_score"] = prot
-        t.loc[pool, "score"] = (rk.weight_accuracy * acc + rk.weight_protection * prot) / w
-        order = t[pool].sort_values(["score", ACCURACY], ascending=[False, True]).index
-    else:
-        order = t[pool].sort_values([USABLE, "k_Nm_per_rad"], ascending=[False, True]).index
+    complete = p[columns].notna().all(axis=1)
+    if complete.any():
+        t.loc[complete[complete].index, "pareto"] = pareto_front(p.loc[complete, columns].to_numpy(float))
+    order = p.sort_values([columns[0], "mass_g", USABLE], ascending=[True, True, False], na_position="last").index
     t.loc[order, "rank"] = np.arange(1, len(order) + 1)
     best = int(order[0])
     second = int(order[1]) if len(order) > 1 else None
-    explanation = explain(t, best, second, bool(feasible.any())) if scored else _explain_carried(t, best, second)
-    return t, Choice(best, second, bool(feasible.any()), explanation)
+    choice = Choice(best, second, bool(feasible.any()), "", bool(not feasible.any() and conditional.any()))
+    return t, replace(choice, explanation=explain(t, choice, study))
 
 
-def _explain_carried(t: pd.DataFrame, best: int, second: int | None) -> str:
-    """Why a pool without objectives chose `best`: the most usable torque."""
-    b = t.loc[best]
+def explain(t: pd.DataFrame, choice: Choice, study: Study) -> str:
+    """Why the chosen candidate wins and what the runner-up trades, in words; for an infeasible choice, what
+    blocks it, by how much, and what would unblock it."""
+    b = t.loc[choice.index]
+    objective = study.requirements.objectives[0]
+    column = OBJECTIVE_COLUMNS[objective]
 
-    def usable(r: pd.Series) -> str:
-        limit = r["large_strain_limit_torque_Nm"]
-        strain = f", the allowable strain passed at {limit:.3g} Nm" if np.isfinite(limit) else ""
-        return (f"{r[USABLE]:.3g} Nm usable (its path stops at {r['large_stop_torque_Nm']:.3g} Nm, "
-                f"{r['large_stop_rotation_rad']:.3g} rad: {r['large_stop_reason']}{strain})")
+    def value(r: pd.Series) -> str:
+        return f"{OBJECTIVE_WORDS[objective]} {r[column]:.4g}" if np.isfinite(r[column]) else \
+            f"no {OBJECTIVE_WORDS[objective]} (its path stops at {r['large_stop_torque_Nm']:.3g} Nm: {r['large_stop_reason']})"
 
-    text = (f"No candidate meets every hard constraint, and the ones failing the fewest "
-            f"({int(b['n_failed_constraints'])}: {b['failed_constraints']}) cannot all be scored, so the choice is "
-            f"the one with the most usable torque, the most it carries before its path stops and within the "
-            f"allowable strain: {b['candidate']}, {usable(b)}; small-load k {b['k_Nm_per_rad']:.3g} Nm/rad.")
-    if second is not None:
-        text += f" Next: {t.loc[second, 'candidate']}, {usable(t.loc[second])}."
+    facts = (f"small-load k {b['k_Nm_per_rad']:.3g} Nm/rad, working-range tangent "
+             f"{b['working_min_tangent_k_Nm_per_rad']:.3g}-{b['working_max_tangent_k_Nm_per_rad']:.3g} Nm/rad, "
+             f"{b['mass_g']:.3g} g; its path ends at {b['large_stop_torque_Nm']:.3g} Nm, "
+             f"{b['large_stop_rotation_rad']:.3g} rad ({b['large_stop_reason']})")
+    if choice.feasible:
+        text = f"{b['candidate']} meets every requirement and has the smallest {value(b)}: {facts}."
+    elif choice.conditional:
+        text = (f"No candidate meets every requirement with each judged. {b['candidate']} meets every requirement "
+                f"that can be judged, with the smallest {value(b)}, but is only conditional: {b['not_judged']}. "
+                f"It is {facts}.")
+    else:
+        text = (f"No candidate meets every requirement: NOT a recommendation. The closest ({int(b['n_failed_constraints'])} "
+                f"missed) is {b['candidate']}, which misses {blocking(b, study)}; {facts}.")
+        if b["not_judged"]:
+            text += f" Not judged: {b['not_judged']}."
+        text += " " + unblock(b, study)
+    if choice.runner_up is not None:
+        r = t.loc[choice.runner_up]
+        text += f" Runner-up: {r['candidate']}, {value(r)}" + ("." if not r["failed_constraints"] else
+                                                                f", missing {r['failed_constraints']}.")
     return text
 
 
-def explain(t: pd.DataFrame, best: int, second: int | None, feasible: bool) -> str:
-    """Why the chosen candidate wins and what the runner-up trades, in words."""
-    b = t.loc[best]
-    text = (f"{b['candidate']} wins with score {b['score']:.2f} (accuracy {b['accuracy_score']:.2f}, protection "
-            f"{b['protection_score']:.2f}): {b['large_stall_rotation_rad']:.3g} rad at the stall torque "
-            f"(secant k {b['large_stall_secant_k_Nm_per_rad']:.3g} Nm/rad, small-load k {b['k_Nm_per_rad']:.3g}), "
-            f"{b[ACCURACY]:.3g} mm at the bearing, {b[PROTECTION]:.3g} Nm peak strike torque into the gearbox.")
-    if not feasible:
-        text = (f"No candidate meets every hard constraint; the choice is among those failing the fewest "
-                f"({int(b['n_failed_constraints'])}: {b['failed_constraints']}). ") + text
-    if second is not None:
-        r = t.loc[second]
-        acc_word = "more accurate" if r[ACCURACY] < b[ACCURACY] else "less accurate"
-        prot_word = "protects the gearbox better" if r[PROTECTION] < b[PROTECTION] else "protects the gearbox less"
-        text += (f" The runner-up {r['candidate']} (score {r['score']:.2f}) is {acc_word} "
-                 f"({r[ACCURACY]:.3g} mm) but {prot_word} ({r[PROTECTION]:.3g} Nm)."
-                 if (r[ACCURACY] < b[ACCURACY]) != (r[PROTECTION] < b[PROTECTION]) else
-                 f" The runner-up {r['candidate']} (score {r['score']:.2f}) is {acc_word} ({r[ACCURACY]:.3g} mm) "
-                 f"and {prot_word} ({r[PROTECTION]:.3g} Nm).")
-    return text
+def blocking(row: pd.Series, study: Study) -> str:
+    """The requirements a design misses, each with the fraction it misses by, the worst first."""
+    missed = [(float(row[r.column]), r.words) for r in requirement_list(study)
+              if np.isfinite(row.get(r.column, np.nan)) and row[r.column] < 0]
+    return "; ".join(f"{words} (by {100 * -m:.3g} %)" for m, words in sorted(missed)) or "nothing judged"
+
+
+def unblock(row: pd.Series, study: Study) -> str:
+    """What would unblock a design that misses requirements, in words."""
+    hints = []
+    if any(row.get(f"{load}_travel_margin", 0.0) < 0 for load in study.requirements.loads):
+        reason = row["large_stop_reason"]
+        hints.append(f"its path ends in {reason} before a load: contact carrying the load past the closing gap "
+                     "(self-contact in the path) or a larger envelope" if reason == "contact" else
+                     f"its path ends in {reason} before a load: a stiffer material or a larger envelope")
+    if row.get("torque_resolution_margin", 0.0) < 0 or row.get("k_max_margin", 0.0) < 0:
+        hints.append("a softer spring (thinner or fewer beams, a softer material)")
+    if any(row.get(c, 0.0) < 0 for c in ("standing_margin", "natural_frequency_margin", "k_min_margin",
+                                         "foot_error_margin")):
+        hints.append("a stiffer spring (more or wider beams, a stiffer material)")
+    if any(row.get(f"{load}_strain_margin", 0.0) < 0 for load in study.requirements.loads):
+        hints.append("lower strain: longer beams, larger fillets, or a material with a higher sourced limit")
+    if row.get("not_judged"):
+        hints.append("a material with a sourced value for each missing datum")
+    return ("What would unblock it: " + "; ".join(hints) + ".") if hints else ""
 
 
 def standing_verdict(ranked: pd.DataFrame, candidate: str, study: Study) -> str:
@@ -199,9 +219,12 @@ def standing_verdict(ranked: pd.DataFrame, candidate: str, study: Study) -> str:
     row = ranked.loc[ranked["candidate"] == candidate].iloc[0]
     limit = study.requirements.max_standing_deflection_deg
     deg = float(row["standing_deflection_deg"])
-    verdict = "carries" if deg < limit else "does NOT carry"
+    if limit is None:
+        verdict, limit_words = ("carries" if np.isfinite(deg) else "does NOT carry"), "no sag limit"
+    else:
+        verdict, limit_words = ("carries" if deg < limit else "does NOT carry"), f"limit {limit:g} deg"
     return (f"{candidate}: k {row['k_Nm_per_rad']:.4g} Nm/rad, standing deflection {deg:.3g} deg under "
-            f"{row['standing_knee_torque_Nm']:.3g} Nm (limit {limit:g} deg): {verdict} the standing load")
+            f"{row['standing_knee_torque_Nm']:.3g} Nm ({limit_words}): {verdict} the standing load")
 
 
 def calibration_summary(base: pd.DataFrame, base_choice: Choice, calibrated: pd.DataFrame, choice: Choice,

@@ -2,37 +2,52 @@
 
 A margin is >= 0 when the requirement is met (by that fraction of its limit) and < 0 when it is
 missed (by that fraction); NaN when it cannot be judged: a load the path does not carry has no strain
-to read there (the load's travel requirement fails instead), and a material without a sourced
-elongation at yield has no allowable strain. The margins are continuous across each limit, so the
-explorer can model them and add the misses up (`total_violation`). Everything but k is read from the
-large-deflection path (`large_` columns; `rank.physical_columns`); k is the small-load stiffness,
-which the linear solve gives on the finer result mesh (the path's tangent at rest equals it on the
-same mesh).
+to read there (the load's travel requirement fails instead), and a material without a sourced strain limit
+for a load's class has no allowable strain there. A requirement that cannot be judged is not met
+(`rank.constraint_columns`); `not_judged` says which datum is missing and the value it must reach. The
+margins are continuous across each limit, so the explorer can model them and add the misses up
+(`total_violation`). Everything but the explicit k range is read from the large-deflection path (`large_`
+columns; `rank.physical_columns`); that range bounds the small-load k, which the linear solve gives on the
+finer result mesh (the path's tangent at rest equals it on the same mesh).
 
-Per requirement (T: the load's torque; travel: the torque where the path stops):
-- k range: k / k_min - 1 and 1 - k / k_max;
+Per requirement (T: the load's torque; travel: the torque where the path stops; the working range: rest to
+the stall torque, or to the stop when the path stops before it):
 - standing sag: 1 - sag / limit, or travel / T_standing - 1 when the path stops before the standing load;
+- foot error at stall: 1 - lower leg x stall rotation / limit, or travel / T_stall - 1;
+- sensor resolution: 1 - the working range's largest tangent x one count (rad) / limit;
+- natural frequency: sqrt(the working range's smallest tangent / J) / 2 pi / limit - 1;
+- strike torque: 1 - strike torque / limit; where the curve stops before storing the strike's energy, the
+  smaller of 1 - stop torque / limit and stored energy / strike energy - 1 (a miss);
+- k range: k / k_min - 1 and 1 - k / k_max;
 - each load carried (no contact or other stop before it): travel / T - 1; zero when contact is the
   study's end stop and carries it;
-- the strain at each load: T_strain / T - 1 where the peak strain reaches the allowable at T_strain;
-  where it never does on a path that carries the load, allowable / peak strain at the load - 1;
+- the tensile strain at each load against its class's limit (stall: cyclic, impact: single-event):
+  T_limit / T - 1 where the tensile strain reaches the limit at T_limit; where it never does on a path that
+  carries the load, limit / strain at the load - 1;
 - the envelope: 1 - outer diameter / limit and 1 - axial thickness / limit.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
+from seadesign.design.requirements import RAD_PER_COUNT
 from seadesign.design.study import Study
 
 ACCURACY = "large_stall_bearing_displacement_mm"  # the arc the bearing circle turns through at the stall torque
 PROTECTION = "impact_gearbox_torque_Nm"  # the peak torque a foot strike drives into the gearbox
-USABLE = "usable_torque_Nm"  # the most a design carries before its path stops and within the allowable strain
-OBJECTIVE_COLUMNS = {"mass": "mass_g", "accuracy": ACCURACY, "protection": PROTECTION}
-OBJECTIVE_WORDS = {"mass": "mass (g)", "accuracy": "stall bearing arc (mm)", "protection": "strike torque into the gearbox (Nm)"}
+USABLE = "usable_torque_Nm"  # the most a design carries before its path stops and within the cyclic strain limit
+STRAIN_USE = "strain_use"  # the largest share of a load's strain limit its tensile strain uses (1: at the limit)
+OBJECTIVE_COLUMNS = {"mass": "mass_g", "accuracy": ACCURACY, "protection": PROTECTION, "strain_margin": STRAIN_USE,
+                     "softest_k": "k_Nm_per_rad"}
+OBJECTIVE_WORDS = {"mass": "mass (g)", "accuracy": "stall bearing arc (mm)",
+                   "protection": "strike torque into the gearbox (Nm)",
+                   "strain_margin": "share of the strain limit used (-)", "softest_k": "small-load k (Nm/rad)"}
+LOAD_CLASS = {"stall": ("cyclic", "cyclic strain limit"), "impact": ("single", "elongation at yield")}
 
 
 @dataclass(frozen=True)
@@ -47,22 +62,23 @@ def requirement_list(study: Study) -> list[Requirement]:
     """The study's requirements in the order they are reported."""
     req, lc = study.requirements, study.load_cases
     torques = {"stall": lc.stall_torque_Nm, "impact": lc.impact_torque_Nm}
-    allowable = {m.allowable_strain(study.ranking.safety_factor) for m in study.materials.values()}
-    limit = f"{allowable.pop():.3g}" if len(allowable) == 1 and None not in allowable else "the allowable"
-    out = []
+    out = [Requirement(f"{load}_travel_margin", f"carries the {load} torque ({torques[load]:.3g} Nm)")
+           for load in req.loads]
     for load in req.loads:
-        out.append(Requirement(f"{load}_travel_margin", f"carries the {load} torque ({torques[load]:.3g} Nm)"))
-    for load in req.loads:
-        out.append(Requirement(f"{load}_strain_margin", f"{load} strain < {limit}"))
-    out.append(Requirement("standing_margin", f"standing deflection < {req.max_standing_deflection_deg:g} deg"))
-    if req.k_min_Nm_per_rad is not None:
-        out.append(Requirement("k_min_margin", f"k >= {req.k_min_Nm_per_rad:g} Nm/rad"))
-    if req.k_max_Nm_per_rad is not None:
-        out.append(Requirement("k_max_margin", f"k <= {req.k_max_Nm_per_rad:g} Nm/rad"))
-    if req.max_outer_diameter_mm is not None:
-        out.append(Requirement("outer_diameter_margin", f"outer diameter <= {req.max_outer_diameter_mm:g} mm"))
-    if req.max_thickness_mm is not None:
-        out.append(Requirement("thickness_margin", f"axial thickness <= {req.max_thickness_mm:g} mm"))
+        kind = "cyclic" if LOAD_CLASS[load][0] == "cyclic" else "single-event"
+        out.append(Requirement(f"{load}_strain_margin", f"{load} tensile strain within the {kind} limit"))
+    for column, limit, words in (
+            ("standing_margin", req.max_standing_deflection_deg, "standing deflection <= {:g} deg"),
+            ("foot_error_margin", req.max_stall_foot_error_mm, "foot error at stall <= {:g} mm"),
+            ("torque_resolution_margin", req.max_torque_per_count_Nm, "one sensor count <= {:g} Nm"),
+            ("natural_frequency_margin", req.min_natural_frequency_Hz, "natural frequency >= {:g} Hz"),
+            ("strike_margin", req.max_strike_torque_Nm, "strike torque into the gearbox <= {:g} Nm"),
+            ("k_min_margin", req.k_min_Nm_per_rad, "k >= {:g} Nm/rad"),
+            ("k_max_margin", req.k_max_Nm_per_rad, "k <= {:g} Nm/rad"),
+            ("outer_diameter_margin", req.max_outer_diameter_mm, "outer diameter <= {:g} mm"),
+            ("thickness_margin", req.max_thickness_mm, "axial thickness <= {:g} mm")):
+        if limit is not None:
+            out.append(Requirement(column, words.format(limit)))
     return out
 
 
@@ -71,16 +87,49 @@ def _col(t: pd.DataFrame, name: str) -> pd.Series:
 
 
 def _load_margins(t: pd.DataFrame, load: str, torque_Nm: float, end_stop: bool) -> tuple[pd.Series, pd.Series]:
-    """(travel, strain) margins at one load."""
+    """(travel, strain) margins at one load, the strain against the load class's limit."""
     travel_end = _col(t, "large_stop_torque_Nm")
     carried = _col(t, f"large_{load}_rotation_rad").notna()  # reached, or held by contact as the end stop
     at_end_stop = carried & (travel_end < torque_Nm) if end_stop else pd.Series(False, index=t.index)
     travel = (travel_end / torque_Nm - 1.0).where(~at_end_stop, 0.0)
-    crossing = _col(t, "large_strain_limit_torque_Nm")
+    crossing = _col(t, f"large_{LOAD_CLASS[load][0]}_limit_torque_Nm")
     strain = (crossing / torque_Nm - 1.0).where(crossing.notna())
-    never = crossing.isna() & carried  # allowable / peak - 1 (NaN: no allowable strain)
-    strain[never] = (_col(t, "large_allowable_strain") / _col(t, f"large_{load}_peak_strain") - 1.0)[never]
+    never = crossing.isna() & carried  # limit / strain - 1 (NaN: no sourced limit)
+    strain[never] = (_col(t, f"large_{load}_strain_limit") / _col(t, f"large_{load}_tensile_strain") - 1.0)[never]
     return travel, strain
+
+
+def working_tangents(row: pd.Series, stall_torque_Nm: float) -> np.ndarray:
+    """The path's tangent stiffness (Nm/rad) at its points up to the stall torque (and at it, interpolated)."""
+    if not isinstance(row.get("large_curve_torque_Nm"), (list, tuple, np.ndarray)):
+        return np.array([])
+    torque = np.asarray(row["large_curve_torque_Nm"], float)
+    tangent = np.asarray(row["large_curve_tangent_Nm_per_rad"], float)
+    inside = torque <= stall_torque_Nm
+    if inside.all() or not inside.any():
+        return tangent[inside]
+    i = int(np.argmin(inside))  # the first point past the stall torque
+    s = (stall_torque_Nm - torque[i - 1]) / (torque[i] - torque[i - 1])
+    return np.append(tangent[inside], tangent[i - 1] + s * (tangent[i] - tangent[i - 1]))
+
+
+def working_range(t: pd.DataFrame, study: Study) -> pd.DataFrame:
+    """Each solved row's smallest and largest tangent stiffness (Nm/rad) over the working range, the natural
+    frequency (Hz) of the knee's inertia on the smallest, and the torque one sensor count stands for (Nm)."""
+    stall, inertia = study.load_cases.stall_torque_Nm, study.ranking.knee_inertia_kg_m2
+    tangents = [working_tangents(r, stall) if ok else np.array([]) for ok, (_, r) in zip(t["status"] == "ok", t.iterrows())]
+    lo = pd.Series([x.min() if len(x) else np.nan for x in tangents], index=t.index)
+    hi = pd.Series([x.max() if len(x) else np.nan for x in tangents], index=t.index)
+    return pd.DataFrame({"working_min_tangent_k_Nm_per_rad": lo, "working_max_tangent_k_Nm_per_rad": hi,
+                         "natural_frequency_Hz": np.sqrt(lo.clip(lower=0.0) / inertia) / (2 * math.pi),
+                         "torque_per_count_Nm": hi * RAD_PER_COUNT})
+
+
+def _strike_margin(t: pd.DataFrame, study: Study, limit_Nm: float) -> pd.Series:
+    strike, stop = _col(t, PROTECTION), _col(t, "large_stop_torque_Nm")
+    stored = _col(t, "large_stop_energy_J") / _col(t, "strike_energy_J") - 1.0
+    short = np.minimum(1.0 - stop / limit_Nm, stored)
+    return (1.0 - strike / limit_Nm).where(strike.notna(), short)
 
 
 def margins(t: pd.DataFrame, study: Study) -> pd.DataFrame:
@@ -95,10 +144,21 @@ def margins(t: pd.DataFrame, study: Study) -> pd.DataFrame:
         out[f"{load}_travel_margin"], strain[load] = _load_margins(t, load, torques[load], study.ranking.contact_is_end_stop)
     for load in req.loads:
         out[f"{load}_strain_margin"] = strain[load]
-    sag = _col(t, "standing_deflection_deg")
-    standing = study.robot.standing_knee_torque_Nm
-    out["standing_margin"] = (1.0 - sag / req.max_standing_deflection_deg).where(
-        sag.notna(), _col(t, "large_stop_torque_Nm") / standing - 1.0)
+    travel = _col(t, "large_stop_torque_Nm")
+    if req.max_standing_deflection_deg is not None:
+        sag = _col(t, "standing_deflection_deg")
+        out["standing_margin"] = (1.0 - sag / req.max_standing_deflection_deg).where(
+            sag.notna(), travel / study.robot.standing_knee_torque_Nm - 1.0)
+    if req.max_stall_foot_error_mm is not None:
+        error = _col(t, "stall_foot_error_mm")
+        out["foot_error_margin"] = (1.0 - error / req.max_stall_foot_error_mm).where(
+            error.notna(), travel / lc.stall_torque_Nm - 1.0)
+    if req.max_torque_per_count_Nm is not None:
+        out["torque_resolution_margin"] = 1.0 - _col(t, "torque_per_count_Nm") / req.max_torque_per_count_Nm
+    if req.min_natural_frequency_Hz is not None:
+        out["natural_frequency_margin"] = _col(t, "natural_frequency_Hz") / req.min_natural_frequency_Hz - 1.0
+    if req.max_strike_torque_Nm is not None:
+        out["strike_margin"] = _strike_margin(t, study, req.max_strike_torque_Nm)
     k = _col(t, "k_Nm_per_rad")
     if req.k_min_Nm_per_rad is not None:
         out["k_min_margin"] = k / req.k_min_Nm_per_rad - 1.0
@@ -111,6 +171,34 @@ def margins(t: pd.DataFrame, study: Study) -> pd.DataFrame:
         if req.max_thickness_mm is not None:
             out["thickness_margin"] = 1.0 - env["axial_thickness_mm"] / req.max_thickness_mm
     return out.where(solved)
+
+
+def strain_use(t: pd.DataFrame, study: Study) -> pd.Series:
+    """The largest share of its class's strain limit a required load's tensile strain uses (NaN where a
+    limit is not sourced or a load not carried): the `strain_margin` objective, minimised."""
+    shares = [_col(t, f"large_{load}_tensile_strain") / _col(t, f"large_{load}_strain_limit")
+              for load in study.requirements.loads]
+    return pd.concat(shares, axis=1).max(axis=1, skipna=False) if shares else pd.Series(np.nan, index=t.index)
+
+
+def not_judged(t: pd.DataFrame, study: Study) -> pd.Series:
+    """Per row, the requirements that cannot be judged for lack of a sourced material datum, each with the value
+    the datum must reach for the design to pass: "passes if Cheetah's elongation at yield is at least 63.6 %"."""
+    sf = study.ranking.safety_factor
+    out = []
+    for _, row in t.iterrows():
+        needs = []
+        if row["status"] == "ok":
+            material = study.candidate_of_row(row).material
+            for load in study.requirements.loads:
+                strain = float(row.get(f"large_{load}_tensile_strain", np.nan))
+                if not math.isnan(float(row.get(f"large_{load}_strain_limit", np.nan))) or math.isnan(strain):
+                    continue
+                kind, datum = LOAD_CLASS[load]
+                needed = strain * (sf if kind == "single" else 1.0)
+                needs.append(f"{load} strain: passes if {material.name}'s {datum} is at least {100 * needed:.3g} %")
+        out.append("; ".join(needs))
+    return pd.Series(out, index=t.index, dtype=object)
 
 
 def envelope(t: pd.DataFrame, study: Study) -> pd.DataFrame:
