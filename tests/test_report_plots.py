@@ -17,7 +17,8 @@ def test_torque_curve_legend_names_the_choice_then_the_lightest(tmp_path, monkey
                       "mass_g": mass, "large_curve_rotation_rad": [[0.0, 0.1 + 0.01 * i] for i in range(n)],
                       "large_curve_torque_Nm": [[0.0, 20.0] for _ in range(n)], "large_stop_reason": "target_reached",
                       "large_stop_rotation_rad": [0.1 + 0.01 * i for i in range(n)], "large_stop_torque_Nm": 20.0,
-                      "large_strain_limit_rotation_rad": np.nan, "large_strain_limit_torque_Nm": np.nan})
+                      **{f"large_{kind}_limit_{x}": np.nan for kind in ("cyclic", "single")
+                         for x in ("rotation_rad", "torque_Nm")}})
     figures = []
     monkeypatch.setattr(plots.plt, "close", figures.append)
     plots.fig_curves(t, chosen, 10.0, 20.0, tmp_path / "curves.png")

@@ -92,7 +92,7 @@ def _sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: 
            out_dir: Path, calibration: Path | None, cache_dir: Path | None, tolerance_mm: float) -> None:
     """The sweep command's work (see `sweep`)."""
     from seadesign.run.cache import DEFAULT_CACHE_DIR, Cache
-    from seadesign.sweep.rank import calibration_summary, rank
+    from seadesign.sweep.rank import calibration_summary, handoff_verdict, rank
     from seadesign.report import write_outputs
     from seadesign.sweep.stages import SolverSettings
     from seadesign.sweep.runner import run_sweep, sweep_settings
@@ -126,3 +126,5 @@ def _sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: 
         for p in paths:
             if not quiet:
                 click.echo(f"wrote {p}")
+    if "spring" in written:
+        click.echo(f"{written['spring'][0]}: {handoff_verdict(ranked, choice)}")

@@ -81,7 +81,9 @@ def decide(exploration: Exploration, encoding: Encoding, requirement_words: dict
     margins = {c: float(row[c]) for c in requirement_words}
     active = tuple((requirement_words[c], m) for c, m in margins.items() if 0 <= m < ACTIVE_MARGIN)
     missed = tuple(sorted(((requirement_words[c], m) for c, m in margins.items() if m < 0), key=lambda p: p[1]))
-    unjudged = tuple(f"{requirement_words[c]}: {not_judged_why.get(c, 'its load is not carried')}"
-                     for c, m in margins.items() if math.isnan(m))
+    needs = str(row.get("not_judged", "") or "")  # the spring problem names the missing data and the values
+    unjudged = tuple(needs.split("; ")) if needs else tuple(
+        f"{requirement_words[c]}: {not_judged_why.get(c, 'its load is not carried')}"
+        for c, m in margins.items() if math.isnan(m))
     return Decision(index, bool(row["feasible"]), active, missed, unjudged, predicted, p_max)
 

@@ -22,6 +22,7 @@ SOLVED = "solved"  # evaluation column: the full pipeline gave results
 VALID = "valid"  # screening column: the geometry can be built and printed
 TOTAL_VIOLATION = "total_violation"  # sum over requirements of the fraction each is missed by (0: feasible)
 FEASIBLE = "feasible"
+CONDITIONAL = "conditional"  # optional column: every judged requirement met, some not judged (not feasible)
 
 
 class Problem(Protocol):
@@ -59,10 +60,12 @@ def front_mask(t: pd.DataFrame, objectives: tuple[str, ...]) -> pd.Series:
 
 
 def best_index(t: pd.DataFrame, objectives: tuple[str, ...]):
-    """The choice: the feasible design with the smallest first objective; with none feasible, the solved
-    design that misses its requirements by the least in total (None when nothing was solved)."""
-    feasible = t[t[FEASIBLE] & t[objectives[0]].notna()]
-    if len(feasible):
-        return feasible[objectives[0]].idxmin()
+    """The choice: the feasible design with the smallest first objective; with none feasible, the conditional
+    one (when the problem marks them); with none, the solved design that misses its requirements by the least
+    in total (None when nothing was solved)."""
+    for column in (FEASIBLE, CONDITIONAL):
+        pool = t[t[column].astype(bool) & t[objectives[0]].notna()] if column in t else t.iloc[:0]
+        if len(pool):
+            return pool[objectives[0]].idxmin()
     solved = t[t[SOLVED].astype(bool)]
     return solved[TOTAL_VIOLATION].idxmin() if len(solved) else None

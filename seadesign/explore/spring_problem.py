@@ -26,13 +26,13 @@ from seadesign.explore.problem import SOLVED, VALID
 from seadesign.run.cache import Cache
 from seadesign.run.progress import ProgressDisplay
 from seadesign.sweep.rank import constraint_columns, physical_columns
-from seadesign.sweep.requirements import OBJECTIVE_COLUMNS, USABLE, envelope, requirement_list
+from seadesign.sweep.requirements import LOAD_CLASS, OBJECTIVE_COLUMNS, USABLE, envelope, lacks_limit, requirement_list
 from seadesign.sweep.runner import run_candidates
 from seadesign.sweep.stages import SolverSettings
 
 # the physical outputs with a surrogate (units in the names): small-load k, mass, rotation at the stall
-# torque, torque where the path stops (contact onset when it ends in contact), usable torque (where the peak
-# strain reaches the allowable, or the path stops), standing sag
+# torque, torque where the path stops (contact onset when it ends in contact), usable torque (where the tensile
+# strain reaches the cyclic limit, or the path stops), standing sag
 OUTPUTS = ("k_Nm_per_rad", "mass_g", "large_stall_rotation_rad", "large_stop_torque_Nm", USABLE,
            "standing_deflection_deg")
 ENVELOPE_MARGINS = ("outer_diameter_margin", "thickness_margin")
@@ -63,15 +63,17 @@ class SpringProblem:
         self.screened = ("mass_g", *(m for m in ENVELOPE_MARGINS if m in self.margins))
 
     def unjudged(self, column: str, X: np.ndarray) -> np.ndarray:
-        """Where a strain margin cannot be judged: designs of a material without a sourced allowable strain."""
+        """Where a strain margin cannot be judged: designs of a material without a sourced limit for the load's
+        class. The search models the rest, so it finds the best conditional design where nothing can be feasible."""
         none = np.zeros(len(X), bool)
-        if not column.endswith("_strain_margin"):
+        load = column.removesuffix("_strain_margin")
+        if not column.endswith("_strain_margin") or load not in LOAD_CLASS:
             return none
         keys = self.encoding.keys
         if MATERIAL_KEY not in keys:
-            return none | (self.study.material.elongation_at_yield is None)
+            return none | lacks_limit(self.study.material, load)
         axis = self.encoding.axes[keys.index(MATERIAL_KEY)]
-        lacking = np.array([self.study.materials[n].elongation_at_yield is None for n in axis.values])
+        lacking = np.array([lacks_limit(self.study.materials[n], load) for n in axis.values])
         level = self.encoding.snap(X)[:, keys.index(MATERIAL_KEY)] * max(len(axis.values) - 1, 1)
         return lacking[np.rint(level).astype(int)]
 

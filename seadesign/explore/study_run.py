@@ -17,7 +17,7 @@ from seadesign.explore.spring_problem import SpringProblem
 from seadesign.run.cache import Cache
 from seadesign.run.executors import default_jobs, keeping_workers
 from seadesign.run.progress import ProgressDisplay
-from seadesign.sweep.requirements import OBJECTIVE_WORDS, requirement_list
+from seadesign.sweep.requirements import LOAD_CLASS, OBJECTIVE_WORDS, lacks_limit, requirement_list
 from seadesign.sweep.runner import sweep_settings
 from seadesign.sweep.stages import SolverSettings, check_geometry, coarse_k, part_source
 from seadesign.sweep.table import k_error_columns
@@ -34,13 +34,13 @@ class StudyExploration:
 
 
 def not_judged_reasons(study: Study) -> dict[str, str]:
-    """Why a strain margin may not be judged: a material without a sourced elongation at yield."""
-    missing = [m for m in study.materials.values() if m.elongation_at_yield is None]
-    if not missing:
-        return {}
-    why = ("no allowable strain for " + ", ".join(m.name for m in missing)
-           + " (its material file has no sourced elongation at yield)")
-    return {f"{load}_strain_margin": why for load in study.requirements.loads}
+    """Why a strain margin may not be judged: a material without a sourced limit for the load's class."""
+    out = {}
+    for load in study.requirements.loads:
+        missing = [m.name for m in study.materials.values() if lacks_limit(m, load)]
+        if missing:
+            out[f"{load}_strain_margin"] = f"no sourced {LOAD_CLASS[load][1]} for {', '.join(missing)}"
+    return out
 
 
 def explore_study(study: Study, out_dir: Path, loop: LoopSettings, *, solver: SolverSettings = SolverSettings(),

@@ -130,8 +130,10 @@ def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, s
         renders = write_renders(study, row, folder, solver, cache)
         if not export_all:
             cad_rows = t.loc[[choice.index]]
-        selection = {"feasible": choice.feasible, "failed_constraints": str(row["failed_constraints"]),
-                     "score": float(row["score"]), "rank": int(row["rank"]), "explanation": choice.explanation}
+        selection = {"meets_requirements": choice.feasible, "conditional": choice.conditional,
+                     "failed_constraints": str(row["failed_constraints"]), "not_judged": str(row["not_judged"]),
+                     "deciding_objective": study.requirements.objectives[0], "rank": int(row["rank"]),
+                     "explanation": choice.explanation}
         written["spring"] = [write_handoff(study, t, row, folder, settings, selection)]
     written["cad"] = export_cad(study, cad_rows, folder, tolerance_mm)
     written["images"] = [*figures.values(), *renders.values()]

@@ -16,11 +16,13 @@ import pandas as pd
 
 SUMMARY_COLUMNS = [
     "candidate", "status", "mass_g", "k_Nm_per_rad", "k_rel_error", "large_stop_reason", "large_stop_rotation_rad",
-    "large_stop_torque_Nm", "large_strain_limit_torque_Nm", "usable_torque_Nm", "large_stall_rotation_rad", "large_stall_secant_k_Nm_per_rad",
-    "large_stall_tangent_k_Nm_per_rad", "large_stall_bearing_displacement_mm", "large_stall_peak_strain",
+    "large_stop_torque_Nm", "large_cyclic_limit_torque_Nm", "large_single_limit_torque_Nm", "usable_torque_Nm", "large_stall_rotation_rad", "large_stall_secant_k_Nm_per_rad",
+    "large_stall_tangent_k_Nm_per_rad", "large_stall_bearing_displacement_mm", "large_stall_tensile_strain",
+    "large_stall_compressive_strain", "large_impact_tensile_strain",
     "large_stall_strain_margin", "large_stall_survives", "large_impact_survives", "standing_deflection_deg",
+    "working_min_tangent_k_Nm_per_rad", "working_max_tangent_k_Nm_per_rad", "natural_frequency_Hz", "torque_per_count_Nm",
     "impact_gearbox_torque_Nm", "stall_rotation_rad", "stall_von_mises_max_MPa", "thesis_reaction_N",
-    "thesis_displacement_mm", "feasible", "pareto", "score", "rank", "failed_constraints", "reason",
+    "thesis_displacement_mm", "feasible", "conditional", "pareto", "rank", "failed_constraints", "not_judged", "reason",
 ]
 # the compact table's columns: (results column, heading with its unit)
 COMPACT_COLUMNS = [

@@ -37,12 +37,13 @@ def headline(t: pd.DataFrame, d: Decision, objective_words: str, objective: str)
     if d.index is None:
         return "No design could be solved, so none can be chosen."
     r = t.loc[d.index]
-    if d.feasible and d.not_judged:
-        return (f"{r['candidate']} is the lightest solved design that meets every requirement that can be judged "
-                f"({objective_words} {fmt(r[objective])}), but not all can: {'; '.join(d.not_judged)}.")
     if d.feasible:
-        return (f"Print {r['candidate']}: the lightest solved design that meets every requirement "
-                f"({objective_words} {fmt(r[objective])}).")
+        return (f"Print {r['candidate']}: of the solved designs that meet every requirement, each judged, it has the "
+                f"smallest {objective_words} ({fmt(r[objective])}).")
+    if bool(r.get("conditional", False)):
+        return (f"No solved design meets every requirement with each judged. The best conditional design, "
+                f"{r['candidate']} ({objective_words} {fmt(r[objective])}), meets every requirement that can be "
+                f"judged; the rest cannot be: {'; '.join(d.not_judged)}.")
     worst, margin = d.missed[0]
     return (f"No solved design meets every requirement. The nearest, {r['candidate']}, misses "
             f"'{worst}' by {-margin:.0%} (total miss {fmt(r['total_violation'])}).")
@@ -106,8 +107,10 @@ def write_exploration(study: Study, problem, exploration: Exploration, decision:
     if decision.index is not None:
         row = t.loc[decision.index]
         renders = write_renders(study, row, folder, solver, cache)
-        selection = {"feasible": decision.feasible, "failed_constraints": str(row["failed_constraints"]),
-                     "score": None, "rank": 1, "explanation": headline(t, decision, column_label(objective), objective)}
+        selection = {"meets_requirements": decision.feasible, "conditional": bool(row["conditional"]),
+                     "failed_constraints": str(row["failed_constraints"]), "not_judged": str(row["not_judged"]),
+                     "deciding_objective": study.requirements.objectives[0], "rank": 1,
+                     "explanation": headline(t, decision, column_label(objective), objective)}
         written["spring"] = [write_handoff(study, t, row, folder, settings, selection)]
         written["cad"] = export_cad(study, t.loc[[decision.index]], folder, tolerance_mm)
     written["images"] = [*figures.values(), *renders.values()]

@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from seadesign.design.space import axis_label, label  # noqa: E402
-from seadesign.sweep.rank import ACCURACY, PROTECTION  # noqa: E402
+from seadesign.sweep.requirements import ACCURACY, PROTECTION  # noqa: E402
 
 LEGEND_CURVES = 8  # torque curves named in a legend at most (an explorer's front holds dozens)
 _NOT_RED = [f"C{i}" for i in range(10) if i != 3]  # the default colour cycle without its red, the choice's colour
@@ -95,9 +95,9 @@ def fig_pareto(t: pd.DataFrame, chosen: int | None, path: Path) -> Path:
     """Accuracy vs protection objective of every solved candidate; front, pool and choice marked."""
     fig, ax = plt.subplots(figsize=(6, 4.5))
     solved = t[t["status"] == "ok"]
-    pool = solved[solved["score"].notna()]
+    pool = solved[solved["rank"].notna()]
     ax.plot(solved[ACCURACY], solved[PROTECTION], "o", color="0.7", label="solved, not in the pool")
-    ax.plot(pool[ACCURACY], pool[PROTECTION], "o", color="C0", label="pool (feasible, or fewest violations)")
+    ax.plot(pool[ACCURACY], pool[PROTECTION], "o", color="C0", label="pool (feasible, else conditional, else fewest misses)")
     front = pool[pool["pareto"]].sort_values(ACCURACY)
     ax.plot(front[ACCURACY], front[PROTECTION], "-", color="C0", alpha=0.6, label="Pareto front")
     for _, r in solved.iterrows():
@@ -115,7 +115,8 @@ def fig_pareto(t: pd.DataFrame, chosen: int | None, path: Path) -> Path:
 def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: float, path: Path) -> Path:
     """Torque-rotation curves of the large-deflection paths: the Pareto candidates (the ranked pool when it
     could not be scored) in colour, the other solved ones in grey; each curve's stop marked by its reason
-    (x: contact), where the peak strain passes the allowable (o), and the load torques. The legend names at
+    (x: contact), where the tensile strain passes the cyclic (o) and the single-event limit (s), and the load
+    torques. The legend names at
     most LEGEND_CURVES of the coloured curves: the chosen one, then the lightest."""
     fig, ax = plt.subplots(figsize=(7, 6.2))
     solved = t[t["status"] == "ok"]
@@ -134,14 +135,15 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
                 zorder=3 if r["_chosen"] else 2)
         ax.plot(r["large_stop_rotation_rad"], r["large_stop_torque_Nm"], markers.get(r["large_stop_reason"], "s"),
                 color=color, ms=9, mew=2)
-        if np.isfinite(r["large_strain_limit_rotation_rad"]):
-            ax.plot(r["large_strain_limit_rotation_rad"], r["large_strain_limit_torque_Nm"], "o", mfc="none",
-                    color=color, ms=7)
+        for kind, marker in (("cyclic", "o"), ("single", "s")):
+            if np.isfinite(r[f"large_{kind}_limit_rotation_rad"]):
+                ax.plot(r[f"large_{kind}_limit_rotation_rad"], r[f"large_{kind}_limit_torque_Nm"], marker, mfc="none",
+                        color=color, ms=7)
     for torque, name in ((stall_Nm, "stall"), (impact_Nm, "impact")):
         ax.axhline(torque, color="k", ls="--", lw=0.8)
         ax.annotate(f"{name} {torque:.3g} Nm", (0, torque), fontsize=7, xytext=(2, 2), textcoords="offset points")
     ax.set(xlabel="hub rotation (rad)", ylabel="torque (Nm)",
-           title="Large-deflection torque curves (x: contact, o: allowable strain passed)")
+           title="Large-deflection torque curves (x: contact; strain limit passed: o cyclic, s single-event)")
     ax.grid(alpha=0.3)
     more = len(shown) - LEGEND_CURVES
     ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.12),

@@ -9,6 +9,7 @@ import pandas as pd
 
 from seadesign.report.document import Page, compact_table, summary_table
 from seadesign.sweep.rank import Choice
+from seadesign.sweep.requirements import OBJECTIVE_WORDS
 
 RANKED_SHOWN = 10  # candidates in the compact table
 
@@ -59,8 +60,14 @@ def study_text(study) -> str:
 
 
 def objectives_text(study) -> str:
-    rk = study.ranking
-    return ("accuracy = the arc the bearing circle turns through at the stall torque, read from the large-deflection "
+    """The objectives, the deciding one first, and the k window the requirements imply, in words."""
+    rk, objectives = study.ranking, study.requirements.objectives
+    return (f"Deciding objective: {OBJECTIVE_WORDS[objectives[0]]}, minimised among the designs that meet every "
+            "requirement, each judged; mass breaks ties" + (f"; the front also shows {', '.join(OBJECTIVE_WORDS[o] for o in objectives[1:])}"
+                                                          if len(objectives) > 1 else "") + ". "
+            f"{study.k_window.describe()}. Every requirement is judged at the material's room-temperature modulus: "
+            "heat softening (the thesis's spring softened with use, sec. 7) is not modelled. "
+            "Accuracy = the arc the bearing circle turns through at the stall torque, read from the large-deflection "
             "curve (mm); protection = peak torque a foot strike drives into the gearbox: the torque where the curve has "
             "stored the leg's kinetic energy J w^2 / 2, with "
             f"w = {rk.impact_speed_m_per_s:g} m/s / lower leg and J = {rk.knee_inertia_kg_m2:g} kg m^2.")
@@ -77,9 +84,12 @@ def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: 
         headline, feasible = "No candidate was solved, so none can be chosen.", False
     else:
         name = t.loc[choice.index, "candidate"]
-        headline = (f"Print {name}: it meets every requirement and ranks first." if choice.feasible else
-                    f"No candidate meets every requirement; the nearest is {name} "
-                    f"(misses: {t.loc[choice.index, 'failed_constraints']}).")
+        row = t.loc[choice.index]
+        headline = (f"Print {name}: it meets every requirement, each judged, and ranks first." if choice.feasible else
+                    f"No candidate meets every requirement with each judged; {name} meets every judged one, "
+                    f"conditionally: {row['not_judged']}." if choice.conditional else
+                    f"No candidate meets every requirement: NOT a recommendation. The nearest is {name} "
+                    f"(misses: {row['failed_constraints']}).")
         feasible = choice.feasible
     ranked = t[t["rank"].notna()].sort_values("rank").head(RANKED_SHOWN)
     return Page(
@@ -87,7 +97,7 @@ def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: 
         headline=headline, feasible=feasible,
         why=[choice.explanation, f"Requirements that removed candidates: {constraint_counts(t)}.",
              large_deflection_summary(t)],
-        table=compact_table(ranked, [("rank", "rank"), ("score", "score (-)")]),
+        table=compact_table(ranked, [("rank", "rank")]),
         table_caption=f"Ranked candidates (the first {len(ranked)})",
         figures=figures, renders=renders,
         sections=[("Study", study_text(study)), ("Objectives", objectives_text(study)), ("Linear model", LINEAR_NOTE)],

@@ -187,6 +187,16 @@ def explain(t: pd.DataFrame, choice: Choice, study: Study) -> str:
     return text
 
 
+def handoff_verdict(t: pd.DataFrame, choice: Choice) -> str:
+    """Whether the spring handed on meets the requirements, in one line."""
+    row = t.loc[choice.index]
+    if choice.feasible:
+        return f"{row['candidate']} meets every requirement, each judged"
+    if choice.conditional:
+        return f"{row['candidate']} meets every judged requirement; not judged: {row['not_judged']}"
+    return f"{row['candidate']} does NOT meet the requirements (misses: {row['failed_constraints']})"
+
+
 def blocking(row: pd.Series, study: Study) -> str:
     """The requirements a design misses, each with the fraction it misses by, the worst first."""
     missed = [(float(row[r.column]), r.words) for r in requirement_list(study)

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from seadesign.design.materials import Material
 from seadesign.design.requirements import RAD_PER_COUNT
 from seadesign.design.study import Study
 
@@ -181,6 +182,11 @@ def strain_use(t: pd.DataFrame, study: Study) -> pd.Series:
     return pd.concat(shares, axis=1).max(axis=1, skipna=False) if shares else pd.Series(np.nan, index=t.index)
 
 
+def lacks_limit(material: Material, load: str) -> bool:
+    """Whether the material file sources no strain limit for the load's class (cyclic, or single-event)."""
+    return (material.cyclic_strain_limit if LOAD_CLASS[load][0] == "cyclic" else material.elongation_at_yield) is None
+
+
 def not_judged(t: pd.DataFrame, study: Study) -> pd.Series:
     """Per row, the requirements that cannot be judged for lack of a sourced material datum, each with the value
     the datum must reach for the design to pass: "passes if Cheetah's elongation at yield is at least 63.6 %"."""
@@ -192,7 +198,7 @@ def not_judged(t: pd.DataFrame, study: Study) -> pd.Series:
             material = study.candidate_of_row(row).material
             for load in study.requirements.loads:
                 strain = float(row.get(f"large_{load}_tensile_strain", np.nan))
-                if not math.isnan(float(row.get(f"large_{load}_strain_limit", np.nan))) or math.isnan(strain):
+                if not lacks_limit(material, load) or math.isnan(strain):
                     continue
                 kind, datum = LOAD_CLASS[load]
                 needed = strain * (sf if kind == "single" else 1.0)
