@@ -28,3 +28,26 @@ def test_torque_curve_legend_names_the_choice_then_the_lightest(tmp_path, monkey
     assert names == [f"design {chosen}", *lightest]
     assert legend.get_title().get_text().startswith(f"{n - plots.LEGEND_CURVES} more")
     assert (tmp_path / "curves.png").stat().st_size > 0
+
+
+def test_parallel_coordinates_draw_a_categorical_axis_as_its_categories(tmp_path, monkeypatch):
+    """The material axis (strings) is drawn as its categories: each design's line passes through its own
+    material's tick, and the ticks are named (it was drawn as "nan-nan" with no line through it)."""
+    from seadesign.report import explore_plots
+
+    materials = ["ninjaflex", "cheetah", "cheetah", "ninjaflex", "cheetah"]
+    evaluated = pd.DataFrame({"thickness_mm": [6.0, 8.0, 10.0, 12.0, 14.0], "material": pd.array(materials, dtype="str"),
+                              "mass_g": [20.0, 25.0, 30.0, 35.0, 40.0], "feasible": [True, False, False, True, False],
+                              "conditional": [False, True, False, False, True]})
+    invalid = pd.DataFrame({"thickness_mm": [7.0], "material": pd.array(["cheetah"], dtype="str")})
+    figures = []
+    monkeypatch.setattr(explore_plots.plt, "close", figures.append)
+    explore_plots.fig_parallel(evaluated, invalid, ["thickness_mm", "material"], ["mass_g"], 1, tmp_path / "p.png")
+    ax = figures[0].axes[0]
+    design_lines = [line for line in ax.get_lines() if len(line.get_xdata()) == 3]
+    assert len(design_lines) == 7  # 5 evaluated, 1 invalid, the choice again
+    # categories sorted: cheetah 0, ninjaflex 1 on the material column (x = 1)
+    expected = [1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]  # the five evaluated, the invalid one, the choice (cheetah)
+    assert sorted(line.get_ydata()[1] for line in design_lines) == sorted(expected)
+    assert {t.get_text() for t in ax.texts} == {"cheetah", "ninjaflex"}
+    assert "nan" not in " ".join(t.get_text() for t in ax.get_xticklabels())

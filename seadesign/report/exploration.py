@@ -92,7 +92,7 @@ def write_exploration(study: Study, problem, exploration: Exploration, decision:
         "Torque curves of the evaluated designs (front in colour)": fig_curves(
             t, decision.index, study.load_cases.stall_torque_Nm, study.load_cases.impact_torque_Nm,
             folder / "torque_curves.png"),
-        "Evaluated designs (green feasible, orange infeasible, grey invalid geometry; red the choice)": fig_parallel(
+        "Evaluated designs (green feasible, blue conditional, orange infeasible, grey invalid geometry; red the choice)": fig_parallel(
             t, screened[~screened["valid"].astype(bool)], keys, [*problem.objectives, "total_violation"],
             decision.index, folder / "parallel_coordinates.png"),
         "The search: best feasible design and least total violation against full evaluations": fig_history(

@@ -48,17 +48,21 @@ def fig_sobol(indices: pd.DataFrame, path: Path) -> Path:
 
 def fig_parallel(evaluated: pd.DataFrame, invalid: pd.DataFrame, axes: list[str], columns: list[str],
                  chosen, path: Path) -> Path:
-    """Each design a line through its axis values and outputs (each scaled to its range, labels with the range):
-    feasible green, infeasible orange, invalid geometry grey (screened only), the choice red."""
+    """Each design a line through its axis values and outputs (each scaled to its range, labels with the range;
+    a categorical axis, such as the material, has its categories as ticks, evenly spaced): feasible green,
+    conditional blue, infeasible orange, invalid geometry grey (screened only), the choice red."""
     cols = [*axes, *columns]
-    frame = pd.concat([evaluated.assign(_kind=np.where(evaluated["feasible"], "feasible", "infeasible")),
-                       invalid.assign(_kind="invalid geometry")], ignore_index=True)
-    numeric = pd.DataFrame({c: pd.Categorical(frame[c]).codes.astype(float) if frame[c].dtype == object
+    conditional = evaluated["conditional"].astype(bool) if "conditional" in evaluated else False
+    kinds = np.where(evaluated["feasible"], "feasible", np.where(conditional, "conditional", "infeasible"))
+    frame = pd.concat([evaluated.assign(_kind=kinds), invalid.assign(_kind="invalid geometry")], ignore_index=True)
+    categories = {c: sorted(frame[c].dropna().unique()) for c in cols if not pd.api.types.is_numeric_dtype(frame[c])}
+    numeric = pd.DataFrame({c: frame[c].map({v: float(i) for i, v in enumerate(categories[c])}) if c in categories
                             else pd.to_numeric(frame[c], errors="coerce") for c in cols})
     lo, hi = numeric.min(), numeric.max()
     scaled = (numeric - lo) / (hi - lo).replace(0, 1)
     fig, ax = plt.subplots(figsize=(max(7.0, 1.1 * len(cols)), 4.4))
-    colours = {"invalid geometry": ("0.75", 0.6), "infeasible": ("C1", 0.8), "feasible": ("C2", 1.0)}
+    colours = {"invalid geometry": ("0.75", 0.6), "infeasible": ("C1", 0.8), "conditional": ("C0", 0.9),
+               "feasible": ("C2", 1.0)}
     for kind, (colour, alpha) in colours.items():
         rows = scaled[frame["_kind"] == kind]
         for i, (_, r) in enumerate(rows.iterrows()):
@@ -67,11 +71,13 @@ def fig_parallel(evaluated: pd.DataFrame, invalid: pd.DataFrame, axes: list[str]
     if chosen is not None:
         ax.plot(range(len(cols)), scaled.iloc[int(np.flatnonzero(evaluated.index == chosen)[0])].to_numpy(float), "-",
                 color="r", lw=2.5, label="choice")
-    labels = []
-    for c in cols:
-        rng = ("/".join(map(str, pd.Categorical(frame[c]).categories)) if frame[c].dtype == object
-               else f"{lo[c]:.3g}-{hi[c]:.3g}")
-        labels.append(f"{column_label(c)}\n{rng}")
+    for j, c in enumerate(cols):  # a categorical axis: its categories as ticks where the lines pass
+        for i, name in enumerate(categories.get(c, ())):
+            y = (i - lo[c]) / ((hi[c] - lo[c]) or 1)
+            ax.plot([j - 0.04, j + 0.04], [y, y], "k-", lw=1.2)
+            ax.annotate(str(name), (j, y), xytext=(4, 2), textcoords="offset points", fontsize=7)
+    labels = [f"{column_label(c)}\n" + ("categories" if c in categories else f"{lo[c]:.3g}-{hi[c]:.3g}")
+              for c in cols]
     ax.set_xticks(range(len(cols)), labels, fontsize=7, rotation=25, ha="right")
     ax.set(yticks=[], title="Evaluated designs (each column scaled to its range)")
     ax.legend(fontsize=7, loc="upper right")
