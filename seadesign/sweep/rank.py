@@ -125,11 +125,12 @@ def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
     """Add physical, constraint and Pareto columns and choose a candidate.
 
     The pool is the feasible candidates; when none is, the conditional ones (every judged requirement met);
-    when none is, the solved candidates that fail the fewest requirements (the choice is then marked
-    infeasible and says what it misses). The pool is ordered by the deciding objective (the first of
-    `[requirements] objectives`), mass breaking ties; a design without that objective (its curve stops before
-    the stall torque or before storing the strike's energy) comes after, by the usable torque. The Pareto
-    front is over all objectives, among the pool's designs that have them all.
+    when none is, the solved candidates that fail the fewest requirements, ordered by the least total miss
+    (the choice is then marked infeasible and says what it misses). A feasible or conditional pool is ordered
+    by the deciding objective (the first of `[requirements] objectives`), mass breaking ties; a design without
+    that objective (its curve stops before the stall torque or before storing the strike's energy) comes
+    after, by the usable torque. The Pareto front is over all objectives, among the pool's designs that have
+    them all.
     """
     t = constraint_columns(physical_columns(table, study), study)
     solved = t["status"] == "ok"
@@ -145,7 +146,9 @@ def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
     complete = p[columns].notna().all(axis=1)
     if complete.any():
         t.loc[complete[complete].index, "pareto"] = pareto_front(p.loc[complete, columns].to_numpy(float))
-    order = p.sort_values([columns[0], "mass_g", USABLE], ascending=[True, True, False], na_position="last").index
+    keys = [columns[0], "mass_g", USABLE] if pool is feasible or pool is conditional else \
+        ["total_violation", columns[0], "mass_g"]  # nothing meets the judged requirements: the least miss first
+    order = p.sort_values(keys, ascending=[True, True, keys[-1] != USABLE], na_position="last").index
     t.loc[order, "rank"] = np.arange(1, len(order) + 1)
     best = int(order[0])
     second = int(order[1]) if len(order) > 1 else None
