@@ -10,8 +10,9 @@ spent or the front stops moving.
    would leave workers idle. Designs are only ever reported from these evaluations: a surrogate steers, it
    never decides.
 3. Stop rule: the budget of full evaluations is spent; or `patience` rounds in a row have not moved
-   the front: no newly verified design entered the verified front (a feasible design that no
-   earlier feasible design dominates), or, while no design is feasible, none lowered the least total
+   the front: no newly verified design entered the verified front (a design meeting every judged requirement
+   that no earlier such design dominates: the search models what can be judged, so where a requirement cannot
+   be judged anywhere it finds the best conditional design), or, while no design is feasible, none lowered the least total
    violation by 1 % of it or more; or the search proposes nothing that was not screened before; or the
    screening budget (`screen_factor` x the budget) is spent. A round whose proposals and spares all screen
    invalid teaches the classifier and does not count as a round of the front.
@@ -31,7 +32,8 @@ from threadpoolctl import threadpool_limits
 
 from seadesign.explore.doe import initial_design, initial_size, pool, unique_rows
 from seadesign.explore.models import Models, fit_models
-from seadesign.explore.problem import FEASIBLE, SOLVED, TOTAL_VIOLATION, VALID, Problem, best_index, front_mask, judge
+from seadesign.explore.problem import (FEASIBLE, MEETS_JUDGED, SOLVED, TOTAL_VIOLATION, VALID, Problem, best_index,
+                                       front_mask, judge)
 from seadesign.explore.search import far_from, propose
 
 SURROGATE_THREADS = 1  # BLAS threads while fitting and searching the surrogates: their matrices are small, and
@@ -57,7 +59,7 @@ class Round:
     index: int
     evaluations: int  # full evaluations so far
     screenings: int  # cheap screenings so far
-    best_objective: float  # first objective of the best feasible design (NaN: none feasible)
+    best_objective: float  # first objective of the best design meeting every judged requirement (NaN: none)
     least_violation: float  # least total violation of a solved design
     front_size: int
     moved: bool
@@ -130,26 +132,26 @@ class _State:
 
 def _summary(state: _State, index: int, moved: bool) -> Round:
     t, objectives = state.evaluated, state.problem.objectives
-    feasible = t[t[FEASIBLE]] if len(t) else t
+    feasible = t[t[MEETS_JUDGED]] if len(t) else t
     solved = t[t[SOLVED].astype(bool)] if len(t) else t
     return Round(index, len(t), len(state.screened),
                  float(feasible[objectives[0]].min()) if len(feasible) else math.nan,
                  float(solved[TOTAL_VIOLATION].min()) if len(solved) else math.nan,
-                 int(front_mask(t, objectives).sum()) if len(t) else 0, moved)
+                 int(front_mask(t, objectives, MEETS_JUDGED).sum()) if len(t) else 0, moved)
 
 
 def _moved(before: pd.DataFrame, after: pd.DataFrame, objectives: tuple[str, ...]) -> bool:
     """Whether the designs added since `before` moved the front (see the module doc)."""
     new = after.iloc[len(before):]
-    old_feasible = before[before[FEASIBLE]] if len(before) else before
-    for _, r in new[new[FEASIBLE]].iterrows():
+    old_feasible = before[before[MEETS_JUDGED]] if len(before) else before
+    for _, r in new[new[MEETS_JUDGED]].iterrows():
         f = r[list(objectives)].to_numpy(float)
         if not np.isfinite(f).all():
             continue
         F = old_feasible[list(objectives)].to_numpy(float) if len(old_feasible) else np.empty((0, len(objectives)))
         if not (np.all(F <= f, axis=1) & np.any(F < f, axis=1)).any():
             return True
-    if len(old_feasible) or after[FEASIBLE].any():
+    if len(old_feasible) or after[MEETS_JUDGED].any():
         return False
     old = before[TOTAL_VIOLATION].min() if len(before) else math.inf
     return bool(after[TOTAL_VIOLATION].min() < old * (1 - VIOLATION_PROGRESS))
@@ -176,7 +178,7 @@ def explore(problem: Problem, settings: LoopSettings, jobs: int = 1) -> Explorat
     while state.evaluations_left > 0:
         index += 1
         verified_F = state.evaluated[list(problem.objectives)].to_numpy(float).copy()
-        verified_F[~state.evaluated[FEASIBLE].to_numpy(bool)] = np.nan
+        verified_F[~state.evaluated[MEETS_JUDGED].to_numpy(bool)] = np.nan
         want = min(settings.batch, state.evaluations_left)
         with threadpool_limits(SURROGATE_THREADS):
             models = fit_models(problem, state.evaluated, state.screened, settings.seed, jobs, SURROGATE_THREADS)
@@ -203,7 +205,7 @@ def explore(problem: Problem, settings: LoopSettings, jobs: int = 1) -> Explorat
             stop = f"the front did not move in {settings.patience} rounds"
             break
     t = state.evaluated.copy()
-    t["front"] = front_mask(t, problem.objectives)
+    t["front"] = front_mask(t, problem.objectives, FEASIBLE if t[FEASIBLE].any() else MEETS_JUDGED)
     best = best_index(t, problem.objectives)
     with threadpool_limits(SURROGATE_THREADS):
         models = fit_models(problem, state.evaluated, state.screened, settings.seed, jobs, SURROGATE_THREADS)

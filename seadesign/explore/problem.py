@@ -21,8 +21,9 @@ from seadesign.sweep.requirements import total_violation
 SOLVED = "solved"  # evaluation column: the full pipeline gave results
 VALID = "valid"  # screening column: the geometry can be built and printed
 TOTAL_VIOLATION = "total_violation"  # sum over requirements of the fraction each is missed by (0: feasible)
-FEASIBLE = "feasible"
+FEASIBLE = "feasible"  # solved, every requirement judged and met
 CONDITIONAL = "conditional"  # optional column: every judged requirement met, some not judged (not feasible)
+MEETS_JUDGED = "meets_judged"  # feasible or conditional: what the search steers by (it models what can be judged)
 
 
 class Problem(Protocol):
@@ -42,17 +43,19 @@ class Problem(Protocol):
 
 
 def judge(rows: pd.DataFrame, problem: Problem) -> pd.DataFrame:
-    """Rows with TOTAL_VIOLATION (inf where not solved) and FEASIBLE (solved, no requirement missed)."""
+    """Rows with TOTAL_VIOLATION (inf where not solved), MEETS_JUDGED (solved, no judged requirement missed) and
+    FEASIBLE (that, and not conditional where the problem marks designs whose requirements are not all judged)."""
     t = rows.copy()
     solved = t[SOLVED].astype(bool)
     t[TOTAL_VIOLATION] = np.where(solved, total_violation(t[list(problem.margins)]), np.inf)
-    t[FEASIBLE] = solved & (t[TOTAL_VIOLATION] == 0.0)
+    t[MEETS_JUDGED] = solved & (t[TOTAL_VIOLATION] == 0.0)
+    t[FEASIBLE] = t[MEETS_JUDGED] & ~t[CONDITIONAL].astype(bool) if CONDITIONAL in t else t[MEETS_JUDGED]
     return t
 
 
-def front_mask(t: pd.DataFrame, objectives: tuple[str, ...]) -> pd.Series:
-    """The feasible designs no other feasible design dominates (objectives minimised)."""
-    pool = t[FEASIBLE] & t[list(objectives)].notna().all(axis=1)
+def front_mask(t: pd.DataFrame, objectives: tuple[str, ...], column: str = FEASIBLE) -> pd.Series:
+    """The designs of `column` (feasible by default) no other such design dominates (objectives minimised)."""
+    pool = t[column] & t[list(objectives)].notna().all(axis=1)
     mask = pd.Series(False, index=t.index)
     if pool.any():
         mask[pool] = pareto_front(t.loc[pool, list(objectives)].to_numpy(float))

@@ -121,7 +121,9 @@ def write_exploration(study: Study, problem, exploration: Exploration, decision:
         headline=headline(t, decision, column_label(objective), objective), feasible=decision.feasible,
         why=why(t, decision, exploration, counts),
         table=compact_table(shown, [(k, k) for k in keys]),
-        table_caption=("The verified front (every design solved on the full path)" if t["front"].any() else
+        table_caption=("The verified front (every design solved on the full path)" if t["feasible"].any() else
+                       "The conditional front (every judged requirement met, some not judged; every design solved on "
+                       "the full path)" if t["front"].any() else
                        "The nearest solved design (no solved design meets every requirement)"),
         figures=figures, renders=renders,
         sections=[("Study", study_text(study)), ("Objectives", objectives_text(study)),
