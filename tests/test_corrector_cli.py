@@ -10,6 +10,7 @@ from click.testing import CliRunner
 
 from seadesign.cli import main
 from seadesign.data import write_recording
+from seadesign.design.spring import write_spring
 from seadesign.twin import Trial, simulate
 from tests.conftest import shared_path
 
@@ -99,3 +100,44 @@ def test_real_recordings_train_and_beat_no_correction():
     table, _ = open_loop_table([NoCorrection(), net], recs, ds, sp.test, sp.name)
     both = table[table.knee == "both"].set_index("candidate")
     assert both.loc["mlp", "mae_rad"] < both.loc["none", "mae_rad"]
+
+
+def _with_curve(spring_dict: dict, end_Nm: float, hard_stop: bool = False) -> dict:
+    """The spring with a linear torque curve T = k theta that ends at `end_Nm`."""
+    k = spring_dict["k_Nm_per_rad"]
+    theta = [0.0, 0.5 * end_Nm / k, end_Nm / k]
+    return {**spring_dict, "torque_curve": {"rotation_rad": theta, "torque_Nm": [k * t for t in theta],
+                                            "source": "fea_large_deflection", "stop_reason": "contact",
+                                            "hard_stop": hard_stop}}
+
+
+def test_train_refuses_before_training_a_spring_whose_curve_ends_before_the_protocol_loads(tmp_path, spring_dict):
+    """The ground protocol loads the thesis spring to a few Nm: a curve that ends at 1 Nm cannot carry it, and train
+    refuses before any training, naming the load, where the curve ends and why, and the remedy; a curve that
+    reaches past the loads, or ends at a hard stop, passes the check."""
+    from seadesign.corrector.preflight import check_spring_range, protocol_loads
+
+    loads = protocol_loads(spring_dict)
+    ground = next(load for load in loads if "ground" in load.what)
+    assert 1.0 < ground.torque_Nm < 20.0  # the leg's weight on a bent knee at k x 0.8, well past 1 Nm
+    spring = write_spring(_with_curve(spring_dict, 1.0), tmp_path / "short.json")
+    res = CliRunner().invoke(main, ["train", "--spring", str(spring), "-o", str(tmp_path / "m")])
+    assert res.exit_code == 2, res.output  # the CLI's exit code for a refused input
+    text = " ".join(res.output.split())
+    assert "the spring cannot carry what training needs: the simulator's ground protocol loads the spring to" in text
+    assert "Its torque curve ends at" in text and "1 Nm (stop reason contact" in text and "Remedy:" in text
+    assert not (tmp_path / "m").exists()
+    check_spring_range(_with_curve(spring_dict, 1.01 * max(load.torque_Nm for load in loads)))  # reaches past: passes
+    check_spring_range(_with_curve(spring_dict, 1.0, hard_stop=True))  # the end stop carries the rest
+
+
+def test_the_simulator_check_reports_a_recording_the_curve_cannot_follow(tmp_path, spring_dict):
+    """Recordings of a spring that deflects past this spring's curve are reported as not checked, not a crash."""
+    from seadesign.corrector.simcheck import check_simulator
+
+    csv = _recording(tmp_path, spring_dict)
+    checks = check_simulator(_with_curve(spring_dict, 0.2), [csv])
+    assert [c.knee for c in checks] == ["l", "r"]
+    for c in checks:
+        assert c.verdict.startswith("not checked: rotation") and "past the spring's torque curve" in c.verdict
+        assert c.text().startswith("sim_walk (") and not c.within_robust_range

@@ -13,6 +13,7 @@ from seadesign.corrector.iterative import iterate as run_iterations
 from seadesign.corrector.models import MODEL_KINDS
 from seadesign.corrector.recordings import load_recordings
 from seadesign.corrector.report import write_table
+from seadesign.corrector.preflight import check_spring_range
 from seadesign.corrector.simcheck import check_simulator
 from seadesign.corrector.splits import SPLITS
 from seadesign.corrector.train import TrainConfig
@@ -87,6 +88,8 @@ def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: 
     cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=max_seconds,
                       batch_size=batch_size, lr=lr)
     root = Path(out) if out else Path("exports") / spring["study"] / "corrector"
+    if set(models) & set(PREVIEW_MODELS):
+        check_spring_range(spring)  # refuses here, before any training, a curve that ends before the protocol's loads
     checks = check_simulator(spring, list(data)) if set(models) & set(PREVIEW_MODELS) else []
     _echo_checks(checks)
     family1 = None

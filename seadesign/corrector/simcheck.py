@@ -16,11 +16,13 @@ with the spring's deflection under the measured effort taken into account.
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
 from seadesign.data import clean, is_hanging, read_recording
+from seadesign.design.spring import CurveRangeError
 from seadesign.loop.engine import SCALE, explain
 from seadesign.loop.sea import robot_declared, robot_loop_data
 
@@ -47,6 +49,8 @@ class SimulatorCheck:
         return {**asdict(self), "within_robust_range": self.within_robust_range}
 
     def text(self) -> str:
+        if math.isnan(self.stiffness_scale):
+            return f"{self.recording} ({self.knee}): {self.verdict}"
         where = "inside" if self.within_robust_range else "OUTSIDE"
         extra = f"; also found: {', '.join(self.found)}" if self.found else ""
         return (f"{self.recording} ({self.knee}): stiffness scale {self.stiffness_scale:.3g} +- {self.stiffness_scale_u:.2g}, "
@@ -61,7 +65,11 @@ def check_simulator(spring: dict[str, Any], paths: list[str | Path]) -> list[Sim
         raw = read_recording(path)
         table = clean(raw, keep_lifted=is_hanging(raw), normalise=False, euler=False, remove_offset=False).table
         for knee in ("l", "r"):
-            ex = explain(robot_loop_data(table, spring, knee), robot_declared(spring))
+            try:
+                ex = explain(robot_loop_data(table, spring, knee), robot_declared(spring))
+            except CurveRangeError as exc:  # a recording of another spring, deflected past this curve's end
+                out.append(SimulatorCheck(path.stem, knee, math.nan, math.nan, (), f"not checked: {exc}"))
+                continue
             scale = ex.final.parameters()[SCALE]["scale"]
             found = tuple(k for k in ex.found if k != SCALE)
             out.append(SimulatorCheck(path.stem, knee, scale["value"], scale["uncertainty"], found, ex.verdict()))
