@@ -133,3 +133,22 @@ def test_the_working_range_reads_tangents_to_the_stall_torque():
     expected = (a + 3 * b * theta[i - 1] ** 2) + (stall - t0) / (t1 - t0) * 3 * b * (theta[i] ** 2 - theta[i - 1] ** 2)
     assert tangents.min() == a and tangents.max() == pytest.approx(expected, rel=1e-12)
     assert len(tangents) == i + 1
+
+
+def test_the_binding_window_requirement_and_a_conflict_found_on_the_curves(tmp_path):
+    """A linear spring k = 40: one sensor count 40 x 2 pi / 4096 = 0.0614 Nm of 0.1 (38.6 % to spare) binds before
+    the sag (2.96 of 10 deg). When each window requirement is met by some design but none meets both, the
+    window's requirements conflict on the computed curves: a finding."""
+    from seadesign.sweep.requirements import window_verdict
+
+    s = with_limits(_study(tmp_path, "max_standing_deflection_deg = 10.0\nmax_torque_per_count_Nm = 0.1"), 0.2)
+    t = constraint_columns(physical_columns(pd.DataFrame([linear_row(s, 0, "a", 40.0, 0.1)]), s), s)
+    assert window_verdict(t, 0, s) == ("At a the window's binding requirement is one sensor count <= 0.1 Nm: met "
+                                       f"with {100 * (1 - 40 * 2 * math.pi / 4096 / 0.1):.3g} % to spare.")
+    # the sag needs k >= 11.9, the count k <= 65.2: a stiff design (70) meets the sag only, a soft one (10) the count only
+    t = constraint_columns(physical_columns(pd.DataFrame([linear_row(s, 0, "stiff", 70.0, 0.1),
+                                                          linear_row(s, 1, "soft", 10.0, 0.1)]), s), s)
+    assert "Finding: the window's requirements conflict on the computed curves" in window_verdict(t, 0, s)
+    t = constraint_columns(physical_columns(pd.DataFrame([linear_row(s, 0, "a", 40.0, 0.1),
+                                                          linear_row(s, 1, "soft", 10.0, 0.1)]), s), s)
+    assert "Finding" not in window_verdict(t, 0, s)  # a meets both

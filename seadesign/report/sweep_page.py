@@ -9,7 +9,7 @@ import pandas as pd
 
 from seadesign.report.document import Page, compact_table, summary_table
 from seadesign.sweep.rank import Choice
-from seadesign.sweep.requirements import OBJECTIVE_WORDS
+from seadesign.sweep.requirements import OBJECTIVE_WORDS, window_verdict
 
 RANKED_SHOWN = 10  # candidates in the compact table
 
@@ -95,8 +95,9 @@ def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: 
     return Page(
         title=f"Design sweep: {study.name}",
         headline=headline, feasible=feasible,
-        why=[choice.explanation, f"Requirements that removed candidates: {constraint_counts(t)}.",
-             large_deflection_summary(t)],
+        why=[choice.explanation, study.k_window.describe() + ". " + ("" if choice.index is None else
+                                                                    window_verdict(t, choice.index, study)),
+             f"Requirements that removed candidates: {constraint_counts(t)}.", large_deflection_summary(t)],
         table=compact_table(ranked, [("rank", "rank")]),
         table_caption=f"Ranked candidates (the first {len(ranked)})",
         figures=figures, renders=renders,

@@ -207,6 +207,31 @@ def not_judged(t: pd.DataFrame, study: Study) -> pd.Series:
     return pd.Series(out, index=t.index, dtype=object)
 
 
+# the margins of the requirements that bound the stiffness (the k window), with their words
+WINDOW_MARGINS = ("standing_margin", "foot_error_margin", "natural_frequency_margin", "k_min_margin",
+                  "torque_resolution_margin", "strike_margin", "k_max_margin")
+
+
+def window_verdict(t: pd.DataFrame, index, study: Study) -> str:
+    """Which of the window's requirements binds at design `index` (the smallest margin), and a finding when the
+    window's requirements conflict on the computed curves: each is met by some solved design, none meets all."""
+    words = {r.column: r.words for r in requirement_list(study) if r.column in WINDOW_MARGINS}
+    if not words:
+        return ""
+    row = t.loc[index, list(words)].astype(float)
+    text = ""
+    if row.notna().any():
+        c = row.idxmin()
+        text = (f"At {t.loc[index, 'candidate']} the window's binding requirement is {words[c]}: "
+                f"{'met with' if row[c] >= 0 else 'missed by'} {100 * abs(row[c]):.3g} % "
+                f"{'to spare' if row[c] >= 0 else ''}".rstrip() + ".")
+    met = t.loc[t["status"] == "ok", list(words)].astype(float) >= 0
+    if len(met) and met.any().all() and not met.all(axis=1).any():
+        text += (" Finding: the window's requirements conflict on the computed curves: each is met by some solved "
+                 "design, but none meets all of " + ", ".join(words.values()) + " together.")
+    return text
+
+
 def envelope(t: pd.DataFrame, study: Study) -> pd.DataFrame:
     """Outer diameter and axial thickness (mm) of each row's design."""
     params = [study.candidate_of_row(r).params for _, r in t.iterrows()]
