@@ -1,14 +1,19 @@
 """Mesh convergence of the large-deflection path: the curve, the contact onset and the peak strain.
 
 Usage: python benchmarks/path_convergence.py [--study wolfgang_knee] [--candidates 8x4,3x8]
-       [--meshes 2,path,1] [--rotations 0.1,0.2,0.3] [--max-step-rad 0.004]
+       [--meshes 2,path,1] [--rotations 0.1,0.2,0.3] [--max-step-rad 0.004] [--strain-levels 0.1,0.2,0.3,0.433]
 Prints, per candidate and mesh (a number: that coarsening of the study's mesh, 1 being the result mesh;
 "path": the sweep's path mesh, the result mesh's in-plane sizing with SolverSettings.path_layers layers
 through the thickness; the finest last), the degrees of freedom, the torque at each listed rotation (Nm), where and why the path stops
-(rad, Nm), the torque where the peak strain passes the allowable strain, the peak strain at the first listed
-rotation, the time, and each number's difference to the coarsest mesh's as each mesh finishes (a
-run stopped early keeps its rows), then the table again against the finest. Contact and strain peaks sit at beam
-roots (fillets), so they converge more slowly than the torque.
+(rad, Nm), the torque where the peak tensile strain passes the single-event limit (elongation at yield / safety
+factor), the peak tensile strain at the first listed rotation, the time, and each number's difference to the
+coarsest mesh's as each mesh finishes (a run stopped early keeps its rows), then the table again against the
+finest. Contact and strain peaks sit at beam roots (fillets), so they converge more slowly than the torque.
+
+`--strain-levels` also prints, per mesh, the torque (Nm) where the peak tensile strain reaches each level, and
+at the end the path mesh's largest overestimate of those torques against the finest mesh over every candidate
+and level: the knock-down the sweep applies to the path's strain-limit torques (`sweep.requirements.
+STRAIN_TORQUE_KNOCKDOWN`).
 """
 
 from __future__ import annotations
@@ -31,8 +36,19 @@ def _number(value: float | None) -> float:
 
 
 def strain_at(path, theta: float) -> float:
-    return float(np.interp(theta, [p.rotation_rad for p in path.points], [p.peak_strain for p in path.points],
+    return float(np.interp(theta, [p.rotation_rad for p in path.points], [p.peak_tensile_strain for p in path.points],
                            right=np.nan))
+
+
+def torque_at_strain(path, level: float) -> float:
+    """The torque (Nm) where the peak tensile strain, linear between the path's points, first reaches `level`."""
+    strain = np.array([p.peak_tensile_strain for p in path.points])
+    above = np.flatnonzero(strain >= level)
+    if not above.size or above[0] == 0:
+        return float("nan")
+    i = int(above[0])
+    s = (level - strain[i - 1]) / (strain[i] - strain[i - 1])
+    return float(path.points[i - 1].torque_Nm + s * (path.points[i].torque_Nm - path.points[i - 1].torque_Nm))
 
 
 def main() -> None:
@@ -41,6 +57,10 @@ def main() -> None:
     ap.add_argument("--candidates", default="8x4,3x8", help="beams x thickness_mm, comma separated")
     ap.add_argument("--meshes", default="2,path,1", help="edge-length factors on the study's mesh, or path")
     ap.add_argument("--rotations", default="0.1,0.2,0.3", help="rotations (rad) where the torque is compared")
+    ap.add_argument("--strain-levels", default="", help="tensile strains (-) whose torques are compared, comma "
+                                                            "separated, e.g. 0.1,0.2,0.3,0.433")
+    ap.add_argument("--study-candidate", default="", help="one design of --study by its axis values, KEY=VALUE;... "
+                                                           "(for a study with continuous axes)")
     ap.add_argument("--max-step-rad", type=float, default=PathSettings().max_step_rad,
                     help="the path's largest step (rad): smaller steps check that no narrow instability is stepped over")
     args = ap.parse_args()
@@ -49,30 +69,53 @@ def main() -> None:
     cache = Cache()
     meshes = args.meshes.split(",")
     rotations = [float(r) for r in args.rotations.split(",")]
+    levels = [float(x) for x in args.strain_levels.split(",") if x]
+    ratios = []  # (candidate, level, path-mesh torque / finest-mesh torque)
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
     print(f"study {st.name}, material {st.material.name} ({st.material.law.model}, C10 {st.material.law.c10_Pa / 1e6:.3g} MPa, D1 {st.material.law.d1_per_Pa * 1e6:.3g} 1/MPa), path settings {settings}")
-    for spec in args.candidates.split(","):
-        n, t = spec.split("x")
-        candidate, part = check_geometry(st, st.candidate(beam_count=int(n), beam_thickness_mm=float(t)), cache)
+    specs = [args.study_candidate] if args.study_candidate else args.candidates.split(",")
+    for spec in specs:
+        if args.study_candidate:
+            values = dict(kv.split("=") for kv in spec.split(";"))
+            chosen = st.candidate(**{k: v if k == "material" else float(v) if "." in v else int(v)
+                                     for k, v in values.items()})
+        else:
+            n, t = spec.split("x")
+            chosen = st.candidate(beam_count=int(n), beam_thickness_mm=float(t))
+        candidate, part = check_geometry(st, chosen, cache)
         part = part or st.check(candidate)[1]
         m, lc = candidate.material, st.load_cases
         print(f"\n{candidate.name}: torque (Nm) at {', '.join(f'{r:g}' for r in rotations)} rad; stop; strain limit "
               f"torque (Nm); peak strain at {rotations[0]:g} rad; in brackets: relative difference to the first "
               f"(coarsest) mesh, then the table again against the finest", flush=True)
-        rows = []
+        rows, at_levels = [], {}
         for c in meshes:
             mesh = (tetrahedralize(st, candidate, part, cache, layers=SolverSettings().path_layers) if c == "path"
                     else tetrahedralize(st, candidate, part, cache, float(c)))
             path = rotation_path(mesh, m.law, lc.impact_torque_Nm, settings)
             ld = large_deflection(path, st.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
-                                  m.allowable_strain(st.ranking.safety_factor))
+                                  m.strain_limits(st.ranking.safety_factor))
             rows.append((c, ld.dofs, [_number(path.torque_at(r)) for r in rotations], path.stop_reason,
-                         ld.stop_rotation_rad, ld.stop_torque_Nm, ld.strain_limit_torque_Nm,
+                         ld.stop_rotation_rad, ld.stop_torque_Nm, ld.single_limit_torque_Nm,
                          strain_at(path, rotations[0]), path.time_s))
             _print_row(rows[-1], rows[0])  # as it comes: a long run leaves its coarse rows
+            if levels:
+                at_levels[c] = [torque_at_strain(path, x) for x in levels]
+                print("    torque (Nm) at tensile strain " + ", ".join(f"{x:g}: {v:.4g}" for x, v in
+                                                                       zip(levels, at_levels[c])), flush=True)
+        if levels and "path" in at_levels and meshes[-1] != "path":
+            for x, tp, tf in zip(levels, at_levels["path"], at_levels[meshes[-1]]):
+                if np.isfinite(tp) and np.isfinite(tf):
+                    ratios.append((candidate.name, x, tp / tf))
         print("  against the finest:")
         for row in rows:
             _print_row(row, rows[-1])
+    if ratios:
+        name, level, worst = max(ratios, key=lambda r: r[2])
+        print("\npath mesh / finest mesh, torque at each tensile strain: " + "; ".join(
+            f"{n} at {x:g}: {r:.4f}" for n, x, r in ratios))
+        print(f"largest path-mesh overestimate: {name} at strain {level:g}: x {worst:.4f}; knock-down on the path's "
+              f"strain-limit torques: {min(1.0, 1.0 / worst):.4f}")
 
 
 def _print_row(row, ref) -> None:

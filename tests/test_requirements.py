@@ -14,7 +14,7 @@ from helpers_curves import linear_row, with_limits
 from seadesign.design.study import DEFAULT_STUDY, load_study
 from seadesign.errors import ConfigError
 from seadesign.sweep.rank import constraint_columns, physical_columns
-from seadesign.sweep.requirements import working_tangents
+from seadesign.sweep.requirements import STRAIN_TORQUE_KNOCKDOWN, working_tangents
 
 KNEE_REQUIREMENTS = re.compile(r"(?ms)^\[requirements\].*\Z")  # the default study's table, its last
 
@@ -100,10 +100,11 @@ def test_margins_change_sign_at_each_limit(tmp_path):
     assert np.isnan(t.loc[0, "stall_strain_margin"])  # no strain to read where the path does not go
     assert t.loc[0, "foot_error_margin"] == pytest.approx(-0.1)  # the travel stands in for the stall's rotation
     assert t.loc[1, "stall_travel_margin"] == pytest.approx(lc.impact_torque_Nm / lc.stall_torque_Nm - 1)
-    assert t.loc[1, "stall_strain_margin"] == pytest.approx(0.25)
+    kd = STRAIN_TORQUE_KNOCKDOWN  # the path mesh's knock-down: torques at a limit x kd, strains at a load / kd
+    assert t.loc[1, "stall_strain_margin"] == pytest.approx(1.25 * kd - 1)
     assert t.loc[2, "k_max_margin"] == pytest.approx(-0.2)
     # never at the limit on the path: limit / strain at the load - 1
-    assert t.loc[2, "impact_strain_margin"] == pytest.approx(0.65 / 1.5 / (0.01 * lc.impact_torque_Nm / 60.0) - 1)
+    assert t.loc[2, "impact_strain_margin"] == pytest.approx(kd * 0.65 / 1.5 / (0.01 * lc.impact_torque_Nm / 60.0) - 1)
     # closed forms of the linear spring k = 40: sag, foot error, one count, natural frequency, strike torque
     J, w = s.ranking.knee_inertia_kg_m2, s.strike_speed_rad_per_s
     assert t.loc[1, "standing_margin"] == pytest.approx(1 - math.degrees(s.robot.standing_knee_torque_Nm / 40) / 10)

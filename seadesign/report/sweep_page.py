@@ -9,7 +9,7 @@ import pandas as pd
 
 from seadesign.report.document import Page, compact_table, summary_table
 from seadesign.sweep.rank import Choice
-from seadesign.sweep.requirements import OBJECTIVE_WORDS, window_verdict
+from seadesign.sweep.requirements import OBJECTIVE_WORDS, STRAIN_TORQUE_KNOCKDOWN, limit_torque, window_verdict
 
 RANKED_SHOWN = 10  # candidates in the compact table
 
@@ -27,14 +27,16 @@ def large_deflection_summary(t: pd.DataFrame) -> str:
             f"within the single-event limit. Torque carried before the path stops: "
             f"{solved['large_stop_torque_Nm'].min():.3g}-{solved['large_stop_torque_Nm'].max():.3g} Nm. Strains are "
             "tensile principal strains (along directions of tensile principal stress); a squeezed region's bulge "
-            "is reported as compression beside them.")
+            "is reported as compression beside them. The path mesh reaches a strain at a higher torque than the "
+            f"default mesh, so its strain-limit torques are knocked down by x {STRAIN_TORQUE_KNOCKDOWN:.3g} (and its "
+            "strains at a load raised by its inverse).")
     for kind, words in (("cyclic", "cyclic strain limit (repeating loads)"),
                         ("single", "single-event strain limit (elongation at yield / safety factor)")):
         limit = solved[f"large_{kind}_strain_limit"].dropna()
         if limit.empty:
             text += f" No sourced {words}: not judged, so not met."
             continue
-        passed = solved[f"large_{kind}_limit_torque_Nm"].dropna()
+        passed = limit_torque(solved, kind).dropna()
         text += (f" {words[0].upper() + words[1:]} {limit.iloc[0]:.3g}: passed by {len(passed)} candidates"
                  + (f", at {passed.min():.3g}-{passed.max():.3g} Nm." if len(passed) else "."))
     return text

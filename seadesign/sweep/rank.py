@@ -36,7 +36,8 @@ from seadesign.design.spring import TorqueCurve
 from seadesign.design.study import Study
 from seadesign.sweep.handoff import curve_to_stop
 from seadesign.sweep.requirements import (OBJECTIVE_COLUMNS, OBJECTIVE_WORDS, PROTECTION, STRAIN_USE, USABLE, margins,
-                                          not_judged, requirement_list, strain_use, total_violation, working_range)
+                                          limit_torque, not_judged, requirement_list, strain_use, total_violation,
+                                          working_range)
 
 
 @dataclass(frozen=True)
@@ -76,7 +77,7 @@ def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
         in t else np.nan
     t["strike_energy_J"] = energy
     if "large_stop_torque_Nm" in t:
-        t[USABLE] = t[["large_stop_torque_Nm", "large_cyclic_limit_torque_Nm"]].min(axis=1, skipna=True)
+        t[USABLE] = pd.concat([t["large_stop_torque_Nm"], limit_torque(t, "cyclic")], axis=1).min(axis=1, skipna=True)
     curves = [TorqueCurve(*map(tuple, curve_to_stop(r))) if ok else None for ok, (_, r) in zip(solved, t.iterrows())]
     t["large_stop_energy_J"] = [np.nan if c is None else c.energy_J for c in curves]
     t[PROTECTION] = [np.nan if c is None else _nan(c.torque_at_energy(energy)) for c in curves]
