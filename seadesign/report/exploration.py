@@ -19,6 +19,7 @@ from seadesign.report.plots import fig_curves
 from seadesign.report.sweep_page import objectives_text, study_text
 from seadesign.run.atomic import atomic_write
 from seadesign.run.cache import Cache
+from seadesign.sweep.requirements import window_verdict
 from seadesign.sweep.stages import SolverSettings
 
 FRONT_SHOWN = 12  # designs in the compact table
@@ -119,7 +120,9 @@ def write_exploration(study: Study, problem, exploration: Exploration, decision:
     page = Page(
         title=f"Design exploration: {study.name}",
         headline=headline(t, decision, column_label(objective), objective), feasible=decision.feasible,
-        why=why(t, decision, exploration, counts),
+        why=[study.k_window.describe() + "." + ("" if decision.index is None else
+                                                " " + window_verdict(t, decision.index, study)),
+             *why(t, decision, exploration, counts)],
         table=compact_table(shown, [(k, k) for k in keys]),
         table_caption=("The verified front (every design solved on the full path)" if t["feasible"].any() else
                        "The conditional front (every judged requirement met, some not judged; every design solved on "
