@@ -144,7 +144,7 @@ def working_range(t: pd.DataFrame, study: Study) -> pd.DataFrame:
                          "torque_per_count_Nm": hi * RAD_PER_COUNT})
 
 
-def _strike_margin(t: pd.DataFrame, study: Study, limit_Nm: float) -> pd.Series:
+def _strike_margin(t: pd.DataFrame, limit_Nm: float) -> pd.Series:
     strike, stop = _col(t, PROTECTION), _col(t, "large_stop_torque_Nm")
     stored = _col(t, "large_stop_energy_J") / _col(t, "strike_energy_J") - 1.0
     short = np.minimum(1.0 - stop / limit_Nm, stored)
@@ -177,7 +177,7 @@ def margins(t: pd.DataFrame, study: Study) -> pd.DataFrame:
     if req.min_natural_frequency_Hz is not None:
         out["natural_frequency_margin"] = _col(t, "natural_frequency_Hz") / req.min_natural_frequency_Hz - 1.0
     if req.max_strike_torque_Nm is not None:
-        out["strike_margin"] = _strike_margin(t, study, req.max_strike_torque_Nm)
+        out["strike_margin"] = _strike_margin(t, req.max_strike_torque_Nm)
     k = _col(t, "k_Nm_per_rad")
     if req.k_min_Nm_per_rad is not None:
         out["k_min_margin"] = k / req.k_min_Nm_per_rad - 1.0
@@ -209,13 +209,13 @@ def not_judged(t: pd.DataFrame, study: Study) -> pd.Series:
     """Per row, the requirements that cannot be judged for lack of a sourced material datum, each with the value
     the datum must reach for the design to pass: "passes if Cheetah's elongation at yield is at least 63.6 %"."""
     sf = study.ranking.safety_factor
+    strains = {load: tensile_strain(t, load) for load in study.requirements.loads}
     out = []
-    for _, row in t.iterrows():
+    for i, row in t.iterrows():
         needs = []
         if row["status"] == "ok":
             material = study.candidate_of_row(row).material
-            for load in study.requirements.loads:
-                strain = float(row.get(f"large_{load}_tensile_strain", np.nan)) / STRAIN_TORQUE_KNOCKDOWN
+            for load, strain in ((load, float(s[i])) for load, s in strains.items()):
                 if not lacks_limit(material, load) or math.isnan(strain):
                     continue
                 kind, datum = LOAD_CLASS[load]
