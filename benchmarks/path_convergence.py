@@ -72,7 +72,7 @@ def main() -> None:
     levels = [float(x) for x in args.strain_levels.split(",") if x]
     ratios = []  # (candidate, level, path-mesh torque / finest-mesh torque)
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
-    print(f"study {st.name}, material {st.material.name} ({st.material.law.model}, C10 {st.material.law.c10_Pa / 1e6:.3g} MPa, D1 {st.material.law.d1_per_Pa * 1e6:.3g} 1/MPa), path settings {settings}")
+    print(f"study {st.name}, path settings {settings}")
     specs = [args.study_candidate] if args.study_candidate else args.candidates.split(",")
     for spec in specs:
         if args.study_candidate:
@@ -85,6 +85,8 @@ def main() -> None:
         candidate, part = check_geometry(st, chosen, cache)
         part = part or st.check(candidate)[1]
         m, lc = candidate.material, st.load_cases
+        print(f"\n{candidate.name}: material {m.name} ({m.law.model}, C10 {m.law.c10_Pa / 1e6:.3g} MPa, D1 "
+              f"{m.law.d1_per_Pa * 1e6:.3g} 1/MPa)")
         print(f"\n{candidate.name}: torque (Nm) at {', '.join(f'{r:g}' for r in rotations)} rad; stop; strain limit "
               f"torque (Nm); peak strain at {rotations[0]:g} rad; in brackets: relative difference to the first "
               f"(coarsest) mesh, then the table again against the finest", flush=True)

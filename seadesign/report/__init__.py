@@ -113,7 +113,7 @@ def write_renders(study: Study, row: pd.Series, folder: Path, solver: SolverSett
         if response is None or render_path(response, float(row["large_stall_strain_limit"]), title, path) is None:
             return {}
         stamp([path], key)
-    return {f"Chosen part {where}, true scale (colour: largest principal strain, %)": path}
+    return {f"Chosen part {where}, true scale (colour: largest tensile principal strain, %)": path}
 
 
 def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, settings: dict, *,
