@@ -20,8 +20,10 @@ def test_a_reduced_knee_exploration_runs_search_rounds_and_never_calls_a_conditi
     study = load_study("wolfgang_knee_explore")
     coarse = dataclasses.replace(study.mesh, elements_across_beam=1.0, elements_per_circle=7.0, layers=1.0)
     study = dataclasses.replace(study, mesh=coarse)
-    run = explore_study(study, tmp_path / "out", LoopSettings(budget=8, batch=2, seed=0), cache=Cache(tmp_path / "c"),
-                        jobs=2, quiet=True)
+    # most of this space cannot be built (the knee run screened 89 of 115 invalid): room for 20 screenings per
+    # evaluation, so that the small budget reaches the search rounds
+    loop = LoopSettings(budget=8, batch=2, seed=0, screen_factor=20)
+    run = explore_study(study, tmp_path / "out", loop, cache=Cache(tmp_path / "c"), jobs=2, quiet=True)
     t = run.exploration.evaluated
     searched = [r for r in run.exploration.rounds if r.index > 0]
     assert len(searched) >= 2, run.exploration.stop_reason  # rounds after the design of experiments
