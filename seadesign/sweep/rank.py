@@ -80,7 +80,7 @@ def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
         t[USABLE] = pd.concat([t["large_stop_torque_Nm"], limit_torque(t, "cyclic")], axis=1).min(axis=1, skipna=True)
     curves = [TorqueCurve(*map(tuple, curve_to_stop(r))) if ok else None for ok, (_, r) in zip(solved, t.iterrows())]
     t["large_stop_energy_J"] = [np.nan if c is None else c.energy_J for c in curves]
-    t[PROTECTION] = [np.nan if c is None else _nan(c.torque_at_energy(energy)) for c in curves]
+    t[PROTECTION] = np.array([None if c is None else c.torque_at_energy(energy) for c in curves], dtype=float)
     t = pd.concat([t.drop(columns=[c for c in ("working_min_tangent_k_Nm_per_rad", "working_max_tangent_k_Nm_per_rad",
                                                "natural_frequency_Hz", "torque_per_count_Nm") if c in t]),
                    working_range(t, study)], axis=1)
@@ -89,10 +89,6 @@ def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
     t["thesis_reaction_N"] = [r for r, _ in thesis]
     t["thesis_displacement_mm"] = [d for _, d in thesis]
     return t
-
-
-def _nan(value: float | None) -> float:
-    return math.nan if value is None else value
 
 
 def _thesis_result(study: Study, row: pd.Series) -> tuple[float, float]:
