@@ -32,6 +32,7 @@ import numpy as np
 
 from seadesign.fea import rotation_path as rp
 from seadesign.fea.assembly import UpperBlocks
+from seadesign.fea.contact import FacingSurfaces
 from seadesign.fea.ccx import path_nodes, run_ccx, run_ccx_path, write_load_case_decks, write_path_inp
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.loadcases import analyse
@@ -51,7 +52,7 @@ PATH_PARTS = {
                                            (Solid, "energy"), (UpperBlocks, "matrix")],
     "factorization (LDL^T with inertia)": [(Pardiso, "__init__"), (Pardiso, "refactor")],
     "solve": [(Pardiso, "solve")],
-    "stop checks (peak strain, contact gap)": [(Solid, "element_strain_stress"), (rp, "_min_gap_mm")],
+    "stop checks (peak strain, contact gap)": [(Solid, "element_strain_stress"), (FacingSurfaces, "min_gap_mm")],
 }
 
 
@@ -191,7 +192,7 @@ def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool) -> None:
     if not use_ccx:
         return
     theta = [p.rotation_rad for p in points]
-    emesh, hub, ring = path_nodes(mesh, law)
+    emesh, hub, ring = path_nodes(mesh)
     with tempfile.TemporaryDirectory() as d:
         cc = run_ccx_path(write_path_inp(Path(d) / "path.inp", emesh, hub, ring, law, theta), emesh.nodes_m, theta)
     n = len(cc.torque_Nm)

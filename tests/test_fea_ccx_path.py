@@ -24,7 +24,7 @@ def _ccx_difference(tmp_path, mesh, law: Hyperelastic, path: TorquePath, beyond_
     in it within two of the path's location tolerances of that point (where the path lost stability)."""
     points = path.points[1:]
     theta = [p.rotation_rad for p in points]
-    emesh, hub, ring = path_nodes(mesh, law)
+    emesh, hub, ring = path_nodes(mesh)
     steps = theta + [theta[-1] + beyond_rad] if beyond_rad else theta
     cc = run_ccx_path(write_path_inp(tmp_path / "path.inp", emesh, hub, ring, law, steps), emesh.nodes_m, steps)
     np.testing.assert_array_equal(cc.rotation_rad, theta)
@@ -77,7 +77,7 @@ def test_calculix_nlgeom_agrees_on_study_candidates(tmp_path, ccx, beams, thickn
 def test_a_step_calculix_does_not_converge_is_named_and_left_out(tmp_path, ccx):
     # 4 rad in one step with increments of at least 0.3 rad: ccx gives up on the second step
     mesh = annulus_mesh(5.0, 12.0, 3.0, n_r=3, n_theta=16, n_z=2)
-    emesh, hub, ring = path_nodes(mesh, LAW)
+    emesh, hub, ring = path_nodes(mesh)
     theta = [0.1, 4.0, 4.1]
     inp = write_path_inp(tmp_path / "path.inp", emesh, hub, ring, LAW, theta, PathIncrements(max_rad=4.0, min_rad=0.3))
     cc = run_ccx_path(inp, emesh.nodes_m, theta)

@@ -13,7 +13,8 @@ from seadesign.fea.elements import element_mesh
 from seadesign.design.materials import StrainLimits
 from seadesign.fea.large_deflection import large_deflection
 from seadesign.fea.results import columns
-from seadesign.fea.rotation_path import PathPoint, TorquePath, _stop_point
+from seadesign.fea.path_events import stop_point
+from seadesign.fea.torque_path import PathPoint, TorquePath
 
 A, B = 15.0, 0.8  # Nm, rad: initial stiffness A / B = 18.75 Nm/rad
 LIMITS = StrainLimits(cyclic=0.3, single=0.433)
@@ -24,7 +25,7 @@ def _path(end_rad: float, reason: str, n: int = 41) -> TorquePath:
     theta = np.linspace(0.0, end_rad, n)
     points = tuple(PathPoint(float(t), A * math.tanh(t / B), A / B / math.cosh(t / B) ** 2, 0.5 * t, math.inf, 3,
                              (1e-9,), 0, 0.2 * t, 0, 2e6 * t, 0) for t in theta)
-    stop = _stop_point(list(points), reason, 1e9, 0.1)
+    stop = stop_point(list(points), reason, 1e9, 0.1)
     return TorquePath(points, reason, *stop, np.zeros((len(emesh.nodes_m), 3)), emesh, 2, 1.5)
 
 

@@ -88,10 +88,9 @@ def test_tangent_at_rest_equals_the_linear_k_with_the_same_hub_constraints():
     # the linear solver's rigid coupling with the hub's translation and tilt held: k = 1 / (K^-1)_zz
     mesh = annulus_mesh(5.0, 12.0, 3.0, n_r=3, n_theta=16, n_z=2)
     path = rotation_path(mesh, Hyperelastic.from_linear(E, 0.48), 1e-3)
-    p = path_problem(mesh, Hyperelastic.from_linear(E, 0.48), PathSettings(), 2, None, None, None, "full")
+    p = path_problem(mesh, Hyperelastic.from_linear(E, 0.48), PathSettings())
     em = p.solid.mesh
-    ring = np.setdiff1d(np.flatnonzero(p.node_index < 0), p.hub)
-    cpl = couple(em.nodes_m, p.hub, ring, np.array([0.0, 0.0, 1.5e-3]))
+    cpl = couple(em.nodes_m, p.drive.hub, p.drive.ring, np.array([0.0, 0.0, 1.5e-3]))
     k = full_from_upper(cpl.condense(stiffness_upper(em, E, 0.48, cpl.node_index, cpl.n_rows)).matrix()).tocsc()
     keep = np.setdiff1d(np.arange(k.shape[0]), cpl.ref_dofs[:5])  # hold t and the tilts
     rhs = np.zeros(len(keep))
@@ -107,10 +106,10 @@ def test_a_thin_plate_in_torsion_stops_where_the_tangent_loses_stability():
     law = Hyperelastic.from_linear(E, 0.45)
     path = rotation_path(mesh, law, 50.0, PathSettings(max_step_rad=0.05))
     assert path.stop_reason == "bifurcation"
-    p = path_problem(mesh, law, PathSettings(), 2, None, None, None, "full")
+    p = path_problem(mesh, law, PathSettings())
 
     def smallest(u):
-        k = full_from_upper(p.solid.tangent(u, p.pattern).matrix()).tocsc()
+        k = full_from_upper(p.solid.tangent(u, p.system.pattern).matrix()).tocsc()
         return sla.eigsh(k, k=1, sigma=0, which="LM", return_eigenvectors=False)[0]
 
     at_rest, at_stop = smallest(np.zeros_like(path.displacement_m)), smallest(path.displacement_m)

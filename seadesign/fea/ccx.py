@@ -24,9 +24,9 @@ import numpy as np
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import SolverError
-from seadesign.fea.elements import ElementMesh
-from seadesign.fea.rotation_path import PathSettings, moment_z, path_problem
-from seadesign.fea.torsion import UnitTorsion
+from seadesign.fea.elements import ElementMesh, element_mesh
+from seadesign.fea.hub_rotation import HubRotation, moment_z
+from seadesign.fea.torsion import MM, UnitTorsion
 from seadesign.mesh.tetmesh import TetMesh
 
 
@@ -186,13 +186,14 @@ def write_load_case_decks(
     }
 
 
-def path_nodes(mesh: TetMesh, law: Hyperelastic, hub_boundaries: list[str] | None = None,
+def path_nodes(mesh: TetMesh, hub_boundaries: list[str] | None = None,
                ring_boundaries: list[str] | None = None) -> tuple[ElementMesh, np.ndarray, np.ndarray]:
-    """The P2 element mesh (m) and the driven hub and held ring nodes (0-based) of `rotation_path`
-    on `mesh` with these boundaries, taken from the path's own set-up (which builds its solid from
-    `law`) so that a deck drives and holds the same nodes."""
-    p = path_problem(mesh, law, PathSettings(), 2, hub_boundaries, ring_boundaries, None, "full")
-    return p.solid.mesh, p.hub, np.setdiff1d(np.flatnonzero(p.node_index < 0), p.hub)
+    """The P2 element mesh (m) and the driven hub and held ring nodes (0-based) of `rotation_path` on `mesh`
+    with these boundaries, from the path's own boundary condition, so that a deck drives and holds the
+    same nodes."""
+    emesh = element_mesh(mesh.points_mm * MM, mesh.tets, 2)
+    drive = HubRotation.on(mesh, emesh, hub_boundaries, ring_boundaries)
+    return emesh, drive.hub, drive.ring
 
 
 _NEVER = 10**9  # a print frequency no step reaches: ccx then prints each step's last increment only
@@ -276,7 +277,7 @@ def run_ccx_path(inp: Path, nodes_m: np.ndarray, rotations_rad: Sequence[float],
                  threads: int | None = None) -> CcxPath:
     """Run a deck from write_path_inp (the same rotations; `nodes_m` the mesh's nodes, m) and read the
     torque of each converged step: sum over the hub nodes of (x + u) x RF, z component, as the path's
-    `_Problem.torque`. Steps ccx did not converge are left out and named in `failure`."""
+    `HubRotation.torque`. Steps ccx did not converge are left out and named in `failure`."""
     inp = Path(inp)
     theta = np.asarray(rotations_rad, dtype=float)
     proc, wall = _run(inp, timeout_s, threads)

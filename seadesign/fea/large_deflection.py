@@ -24,7 +24,7 @@ import numpy as np
 
 from seadesign.design.materials import StrainLimits
 from seadesign.fea.results import nested, unscaled
-from seadesign.fea.rotation_path import TorquePath
+from seadesign.fea.torque_path import TorquePath
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,110 @@
+"""Newton's method for the equilibrium of a hyperelastic body (`fea.equilibrium`): quasi-Newton updates
+between refactorizations and a backtracking line search on the energy."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from seadesign.errors import NotPositiveDefinite
+from seadesign.fea.equilibrium import Equilibrium
+from seadesign.fea.pardiso import Pardiso
+
+@dataclass(frozen=True)
+class NewtonSettings:
+    max_iterations: int = 30
+    refresh_ratio: float = 0.5  # refactor the tangent when an iteration cuts the residual by less than this
+
+
+@dataclass(frozen=True)
+class NewtonResult:
+    """The last iterate u (m), its internal forces (N; None when they could not be evaluated), the residual
+    norms (N) of the iterations and the status: "converged", "unstable" (a tangent that is not positive
+    definite) or "failed"."""
+
+    u: np.ndarray
+    forces: np.ndarray | None
+    residual_norms: list[float]
+    status: str
+
+
+def newton(system: Equilibrium, u0: np.ndarray, settings: NewtonSettings = NewtonSettings()) -> NewtonResult:
+    """Equilibrium of the free nodes from the guess u0 (its prescribed nodes already in place).
+
+    The tangent is refactored only when needed: between refactorizations the tangent last factored (the
+    previous converged state's, or after a cut-back the rejected attempt's) is corrected by BFGS updates
+    from the iterations since (Matthies and Strang's quasi-Newton method for finite elements). It is
+    refactored at the current iterate when an iteration cuts the residual by less than `refresh_ratio`,
+    or its direction finds no descent. A backtracking line search on the energy guards every step."""
+    u = u0.copy()
+    norms: list[float] = []
+    try:
+        f = system.forces(u)
+    except FloatingPointError:
+        return NewtonResult(u, None, norms, "failed")
+    r = system.residual(f)
+    fresh = False  # the held factorization is of the current iterate
+    refresh = system.pardiso is None or not system.pardiso.alive
+    updates: list[tuple[np.ndarray, np.ndarray, float]] = []  # BFGS pairs (s, y, 1 / y.s) since the factorization
+    for _ in range(settings.max_iterations):
+        norms.append(float(np.linalg.norm(r)))
+        if system.converged(f, norms[-1]):
+            return NewtonResult(u, f, norms, "converged")
+        if refresh and not fresh:
+            try:
+                system.factor(u)
+            except NotPositiveDefinite:
+                return NewtonResult(u, f, norms, "unstable")
+            fresh, updates = True, []
+        direction = -_bfgs_solve(system.pardiso, r, updates).reshape(-1, 3)
+        trial, f1 = _line_search(system, u, r, direction, norms[-1])
+        if trial is None:
+            if fresh:
+                return NewtonResult(u, f, norms, "failed")
+            refresh = True
+            norms.pop()
+            continue
+        r1 = system.residual(f1)
+        step, change = (trial[system.free] - u[system.free]).ravel(), r1 - r
+        curvature = float(step @ change)
+        if curvature > 0:
+            updates.append((step, change, 1.0 / curvature))
+        refresh = float(np.linalg.norm(r1)) > settings.refresh_ratio * norms[-1]
+        u, f, r, fresh = trial, f1, r1, False
+    norms.append(float(np.linalg.norm(r)))
+    return NewtonResult(u, f, norms, "converged" if system.converged(f, norms[-1]) else "failed")
+
+
+def _bfgs_solve(factorization: Pardiso, r: np.ndarray, updates: list[tuple[np.ndarray, np.ndarray, float]]) -> np.ndarray:
+    """H r with H the inverse of the factored tangent corrected by the BFGS pairs (the two-loop recursion)."""
+    q, alphas = r.copy(), []
+    for s, y, rho in reversed(updates):
+        alphas.append(rho * float(s @ q))
+        q -= alphas[-1] * y
+    z = factorization.solve(q)
+    for (s, y, rho), alpha in zip(updates, reversed(alphas)):
+        z += (alpha - rho * float(y @ z)) * s
+    return z
+
+
+def _line_search(system: Equilibrium, u: np.ndarray, r: np.ndarray, du: np.ndarray,
+                 norm: float) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """u + alpha du (free nodes) for the first alpha in 1, 1/2, ... 1/1000 whose residual norm is below `norm`,
+    else whose energy falls as Armijo asks; (None, None) when none does."""
+    e0, slope = None, float(r @ du.ravel())
+    alpha = 1.0
+    while alpha > 1e-3:
+        trial = u.copy()
+        trial[system.free] += alpha * du
+        try:
+            f1 = system.forces(trial)
+            if np.linalg.norm(system.residual(f1)) < norm:
+                return trial, f1
+            e0 = system.energy(u) if e0 is None else e0
+            if system.energy(trial) <= e0 + 1e-4 * alpha * slope:
+                return trial, f1
+        except FloatingPointError:  # an element inverted: shorten the step
+            pass
+        alpha *= 0.5
+    return None, None

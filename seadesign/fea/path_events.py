@@ -1,0 +1,64 @@
+"""Events on a torque-rotation path and where the path ends: which event a converged point shows, where
+a closing gap is predicted to reach the contact tolerance (to bracket it), and the stop's rotation and
+torque read from the last points. The reasons are `STOP_REASONS` of `design.spring`."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from seadesign.fea.torque_path import PathPoint, hermite, hermite_inverse
+
+if TYPE_CHECKING:
+    from seadesign.fea.rotation_path import PathSettings
+
+
+def stop_check(s: PathSettings, prev: PathPoint, point: PathPoint, target_Nm: float) -> str | None:
+    """Why the path stops at `point`, if it does; events that end the curve before the target come first,
+    so that the one met first is located (the caller cuts the step until it is)."""
+    if point.tangent_Nm_per_rad <= 0 or point.torque_Nm <= prev.torque_Nm:
+        return "limit_point"
+    if point.min_gap_mm < s.contact_gap_mm:
+        return "contact"
+    if s.allowable_strain is not None and point.peak_tensile_strain > s.allowable_strain:
+        return "strain_limit"
+    if point.torque_Nm >= target_Nm:
+        return "target_reached"
+    if point.rotation_rad >= s.max_rotation_rad:
+        return "rotation_limit"
+    return None
+
+
+def contact_rotation(a: PathPoint, b: PathPoint, s: PathSettings) -> float | None:
+    """Where the gap, linear through a and b, reaches `contact_gap_mm` (rad); None unless both gaps are
+    finite and differ."""
+    if not (np.isfinite(a.min_gap_mm) and np.isfinite(b.min_gap_mm)) or a.min_gap_mm == b.min_gap_mm:
+        return None
+    return a.rotation_rad + (a.min_gap_mm - s.contact_gap_mm) / (a.min_gap_mm - b.min_gap_mm) * (b.rotation_rad - a.rotation_rad)
+
+
+def bracketing_step(contact_rad: float, theta: float, s: PathSettings) -> float:
+    """The step from theta toward a predicted contact: 0.3 of the locating tolerance short of it when it lies
+    further than the tolerance, else as far past it (within the tolerance, so that the bracket locates it)."""
+    tol, ahead = s.contact_locate_tol_rad, contact_rad - theta
+    return ahead - 0.3 * tol if ahead > tol else min(tol, ahead + 0.3 * tol)
+
+
+def stop_point(points: list[PathPoint], reason: str, target_Nm: float, gap_mm: float) -> tuple[float, float]:
+    """Where the path stops: the target torque's rotation, the torque maximum of a limit point, contact
+    where the gap (linear between the last two points) reaches `gap_mm`, else the last point."""
+    last = points[-1]
+    if reason == "target_reached" and len(points) > 1:
+        return hermite_inverse(points[-2], last, target_Nm), target_Nm
+    if reason == "limit_point" and len(points) > 1:
+        a, b = points[-2], last
+        s = np.linspace(0.0, 1.0, 201)
+        t = hermite(a, b, s)
+        i = int(np.argmax(t))
+        return a.rotation_rad + s[i] * (b.rotation_rad - a.rotation_rad), float(t[i])
+    if reason == "contact" and len(points) > 1 and np.isfinite(points[-2].min_gap_mm):
+        a, b = points[-2], last
+        s = float(np.clip((a.min_gap_mm - gap_mm) / (a.min_gap_mm - b.min_gap_mm), 0.0, 1.0))
+        return a.rotation_rad + s * (b.rotation_rad - a.rotation_rad), float(hermite(a, b, s))
+    return last.rotation_rad, last.torque_Nm
