@@ -27,8 +27,9 @@ def _half_annulus(centre, r_in, r_out, normal, n=1500):
 
 
 def _beam(p, i):
-    """Beam i of the definition (DOMAIN.md): two opposed half-annuli of width t about points on the
-    hub circle and on the ring's inner circle, clipped to the gap between them."""
+    """Beam i of the definition (the Bit-Bots family, as measured from their `sea_ninjaflex.stl`): two opposed
+    half-annuli of width t about points on the hub circle and on the ring's inner circle, clipped to the gap
+    between them."""
     phi = math.radians(p.first_beam_angle_deg + 360.0 * i / p.beam_count)
     e = np.array([math.cos(phi), math.sin(phi)])
     normal = np.array([-e[1], e[0]]) * (-1 if p.clockwise else 1)
