@@ -1,7 +1,8 @@
 """The default study's headline numbers, each against an independent reference: which candidates
 are valid (a separate 2-D computation of the beams' clearance and of the fillets' fit, from the
 part's definition, not from the CAD), and the stiffest and softest k (CalculiX on the same mesh).
-When the code changes one of them, this fails and the README is updated on purpose."""
+When the code changes one of them, this fails and the docs (`docs/results/default-sweep.md`) are updated
+on purpose."""
 
 from __future__ import annotations
 
@@ -13,8 +14,8 @@ from shapely.geometry import Polygon
 
 from seadesign.design.study import load_study
 
-VALID_COUNT = 18  # README: "18 of 24 candidates are valid"
-K_HEADLINE = {(3, 4.0): 7.848, (6, 8.0): 33.33}  # README's k range, Nm/rad (softest, stiffest)
+VALID_COUNT = 18  # docs/results/default-sweep.md: "18 of 24 candidates are valid"
+K_HEADLINE = {(3, 4.0): 7.848, (6, 8.0): 33.33}  # the docs' k range, Nm/rad (softest, stiffest)
 
 
 def _half_annulus(centre, r_in, r_out, normal, n=1500):
@@ -27,8 +28,9 @@ def _half_annulus(centre, r_in, r_out, normal, n=1500):
 
 
 def _beam(p, i):
-    """Beam i of the definition (DOMAIN.md): two opposed half-annuli of width t about points on the
-    hub circle and on the ring's inner circle, clipped to the gap between them."""
+    """Beam i of the definition (the Bit-Bots family, as measured from their `sea_ninjaflex.stl`): two opposed
+    half-annuli of width t about points on the hub circle and on the ring's inner circle, clipped to the gap
+    between them."""
     phi = math.radians(p.first_beam_angle_deg + 360.0 * i / p.beam_count)
     e = np.array([math.cos(phi), math.sin(phi)])
     normal = np.array([-e[1], e[0]]) * (-1 if p.clockwise else 1)
@@ -72,4 +74,4 @@ def test_headline_k_agrees_with_calculix_on_the_same_mesh(tmp_path, ccx, beams, 
     deck = write_load_case_decks(tmp_path / "ccx", a.unit, m.youngs_modulus_Pa, m.poisson_ratio, 1.0, 1.0)["stall"]
     k_ccx = 1.0 / run_ccx(deck, len(a.unit.emesh.nodes_m), timeout_s=1800).rotation_rad
     assert a.results.k_Nm_per_rad == pytest.approx(k_ccx, rel=5e-7)
-    assert k_ccx == pytest.approx(K_HEADLINE[(beams, thickness)], rel=1e-3)  # the README's digits
+    assert k_ccx == pytest.approx(K_HEADLINE[(beams, thickness)], rel=1e-3)  # the docs' digits

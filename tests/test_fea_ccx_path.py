@@ -90,8 +90,8 @@ def test_a_step_calculix_does_not_converge_is_named_and_left_out(tmp_path, ccx):
 @pytest.mark.default_mesh
 def test_calculix_nlgeom_agrees_on_the_default_mesh(tmp_path, ccx):
     """3 beams x 6 mm, the smallest of the default study's result meshes (56k tets, 267k degrees of freedom,
-    about the 257k of DOMAIN.md's CalculiX runs), to 0.1 rad, where the secant is 2.9 % below the tangent at
-    rest. Measured: 3.2e-9 to 1.6e-8 apart at the path's 4 rotations; 9 min 34 s with a sweep running beside
+    about the 257k of our first CalculiX NLGEOM check, on the 4 beams x 8 mm stall deck that
+    `seadesign solve --export-ccx` writes), to 0.1 rad, where the secant is 2.9 % below the tangent at rest. Measured: 3.2e-9 to 1.6e-8 apart at the path's 4 rotations; 9 min 34 s with a sweep running beside
     it, CalculiX 15 iterations in 4 increments. Too long for CI (`-m default_mesh`)."""
     from seadesign.design.study import load_study
     from seadesign.run.cache import Cache

@@ -36,8 +36,8 @@ def _arc_term(o, p, q):
 
 
 def expected_corners(p, rho):
-    """Every root corner of the part, from its definition (DOMAIN.md): (corner xy, area in mm^2
-    between the fillet of radius rho and the two circles it is tangent to)."""
+    """Every root corner of the part, from its definition (the Bit-Bots family of `sea_ninjaflex.stl`):
+    (corner xy, area in mm^2 between the fillet of radius rho and the two circles it is tangent to)."""
     out = []
     w = p.beam_thickness_mm / 2
     for i in range(p.beam_count):

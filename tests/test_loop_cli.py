@@ -74,7 +74,7 @@ def test_thesis_worked_example(tmp_path, spring_file):
 
 
 def test_outputs_go_under_exports_by_default(tmp_path, monkeypatch, spring_file, spring_dict):
-    """explain writes exports/explain/<file stem>/, explain-thesis exports/explain_thesis/, and the README's
+    """explain writes exports/explain/<file stem>/, explain-thesis exports/explain_thesis/, and the tutorial's
     `sweep --calibration exports/explain_thesis/thesis_calibration.json` path exists afterwards."""
     chain = bench_effects(9.106).configure("stiffness_scale", enabled=True, scale=0.8)
     table, meta = simulate_bench(spring_dict, BenchProtocol(frequency_hz=0.1, duration_s=20.0), effects=chain, seed=1)

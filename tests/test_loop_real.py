@@ -1,12 +1,13 @@
-"""The loop on the real recordings (`../shared/data/deepsea/`): the README's table of findings, held here.
+"""The loop on the real recordings (`../shared/data/deepsea/`): the table of findings in the docs
+(`docs/validation/_fragments/loop_real.md`, shown on the results page "The loop on real data"), held here.
 
 Each row: `seadesign explain FILE --spring spring_measured.json --knee l|r` (the thesis's measured spring,
 k = 9.106 Nm/rad; the default declared chain: backlash and gear friction; the data module's cleaning): the
 effects named in order, the declared effects the data does not support, the ambiguities reported (winner,
-equally good alternative; the README's remarks under the table), and the held-out RMSE before (the declared
+equally good alternative; the remarks under the table), and the held-out RMSE before (the declared
 model as given) and after, to 1 % (the engine is deterministic: the stored four digits are within 0.03 % of the
-values computed here; the margin is for floating point across machines, where the optimiser's path may differ). When the code changes an answer this test fails, and the README is updated on purpose: the rows are
-also checked against the README's table.
+values computed here; the margin is for floating point across machines, where the optimiser's path may differ). When the code changes an answer this test fails, and the docs are updated on purpose: the rows are
+also checked against the docs' table.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from seadesign.data import KNEE_NAMES, clean, is_hanging, read_recording
 from seadesign.loop import explain
 from seadesign.loop.sea import robot_declared, robot_loop_data
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+TABLE = Path(__file__).resolve().parents[1] / "docs" / "validation" / "_fragments" / "loop_real.md"
 
 # (file, knee): (named effects in order, unsupported declared effects, held-out RMSE before, after (rad))
 ROWS = {
@@ -34,7 +35,7 @@ ROWS = {
     ("d1free", "l"): (["stiffness_scale"], ["backlash", "gear_friction"], 0.01644, 0.005232),
     ("d1free", "r"): (["stiffness_scale"], ["backlash", "gear_friction"], 0.04526, 0.003184),
 }
-# (file, knee): the ambiguities reported, as (winner, alternative), the README's remarks under the table: the left
+# (file, knee): the ambiguities reported, as (winner, alternative), the remarks under the docs' table: the left
 # knee's drift on free_dtest_part1 is an ambiguity with a step; no other row reports one
 AMBIGUITIES = {("free_dtest_part1", "l"): [("sensor_drift", "sensor_step")]}
 
@@ -59,4 +60,4 @@ def test_real_recording_findings_are_the_readmes(spring_dict, name, knee):
     assert ex.plain.errors["held_out"]["rmse"] == pytest.approx(before, rel=0.01)
     assert ex.final.errors["held_out"]["rmse"] == pytest.approx(after, rel=0.01)
     assert ex.final.converged
-    assert readme_row(name, knee) in README.read_text(), "update the README's table to the test's rows"
+    assert readme_row(name, knee) in TABLE.read_text(), f"update {TABLE.name}'s table to the test's rows"

@@ -44,7 +44,7 @@ Stop rule: the validation error has not dropped by more than `min_improvement` (
 result is the best epoch's policy (epoch 0: the initial one) among epochs whose validation commands rest
 without chatter (`closedloop.chatter_rms` below half the oscillation flag's threshold); `max_epochs` and
 `max_seconds` cap the run. One intra-op thread by default: the batch is small and per-step ops dominate,
-so a second thread only adds synchronisation (measured about 10x slower on a shared 2-core machine).
+so a second thread only adds synchronisation (measured in docs/validation/timing.md).
 """
 
 from __future__ import annotations

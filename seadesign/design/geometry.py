@@ -1,6 +1,7 @@
 """The compliant element as a CadQuery solid, built from named parameters (all lengths mm).
 
-Shape (Bit-Bots family, DOMAIN.md): a hub (radius `hub_radius_mm`) and an outer ring joined
+Shape (the family of the Hamburg Bit-Bots' published spring, `sea_ninjaflex.stl`, MIT, as measured from that
+file): a hub (radius `hub_radius_mm`) and an outer ring joined
 by N equally spaced beams of one handedness. Each beam is an "S" of two opposed circular arcs
 of centreline radius `arc_radius_mm` and constant width `beam_thickness_mm`: the first arc is
 centred on the hub circle, the second on the ring's inner circle, and they are tangent half

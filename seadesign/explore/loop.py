@@ -37,7 +37,7 @@ from seadesign.explore.problem import (FEASIBLE, MEETS_JUDGED, SOLVED, TOTAL_VIO
 from seadesign.explore.search import far_from, propose
 
 SURROGATE_THREADS = 1  # BLAS threads while fitting and searching the surrogates: their matrices are small, and
-# more threads made a round 7x slower on two busy cores
+# more threads made a round slower on busy cores (docs/validation/timing.md)
 SPARES_PER_DESIGN = 2  # replacements the search offers per design of the batch, for proposals that screen invalid
 VIOLATION_PROGRESS = 0.01  # a round that lowers the least total violation by less than this fraction does not count
 

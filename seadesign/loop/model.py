@@ -6,7 +6,7 @@
 
 All parameters of all terms are fitted together on the training samples by bounded least
 squares (`scipy.optimize.least_squares`, trust-region reflective with the LSMR subproblem solver,
-4.5x faster than its SVD on a 60 s robot recording with the same answer; positive scale parameters in
+faster than its SVD with the same answer (docs/validation/timing.md); positive scale parameters in
 log space; a parameter whose search bounds are equal is held, e.g. a step's instant). Search
 spaces come from each effect (`Effect.search(data.scales())`); a declared term starts at its
 declared values. The model is evaluated over the whole record (stateful effects need the history);

@@ -1,7 +1,8 @@
 """The thesis case as a worked example: FEA material (generic TPU, E = 0.147 GPa) vs a bench test.
 
 The thesis's FEA of the chosen 9-beam 8 mm part gave 0.3532 mm at r = 14 mm under 11.7 Nm, about
-464 Nm/rad (DOMAIN.md); the bench measured k = 9.106 Nm/rad with a small dead-band around zero.
+464 Nm/rad (Stelter 2022, sec. 5.1, fig. 5.4 and eq. 5.3); the bench measured k = 9.106 Nm/rad with a small
+dead-band around zero (sec. 5.1, fig. 5.5).
 Here the bench file is simulated from the measured k with a dead-band, and the loop explains it
 with the FEA's k: it must find the stiffness scale (9.106 / 464 ~ 0.0196) and the dead-band.
 """

@@ -2,7 +2,7 @@
 
 The path (`fea.rotation_path`, the material's hyperelastic law) runs from rest to the study's impact
 torque or to where it stops, on the result mesh's in-plane sizing with `SolverSettings.path_layers`
-layers through the thickness (its error against the result mesh is in the README's table). `fea.large_deflection`
+layers through the thickness (its error against the result mesh is in docs/validation/mesh-convergence.md). `fea.large_deflection`
 reads it at the standing, stall and impact torques. The result is cached under the mesh, the law,
 the path settings, the torques, the strain limits, the end-stop rule and the code.
 """

@@ -50,10 +50,8 @@ OBJECTIVE_WORDS = {"mass": "mass (g)", "accuracy": "stall bearing arc (mm)",
                    "strain_margin": "share of the strain limit used (-)", "softest_k": "small-load k (Nm/rad)"}
 LOAD_CLASS = {"stall": ("cyclic", "cyclic strain limit"), "impact": ("single", "elongation at yield")}
 # The path mesh (the result mesh's in-plane sizing, one layer through the thickness) reaches a tensile strain at a
-# higher torque than the default mesh: by up to 5.15 % (8 x 4 mm at 10 % strain; 6 x 8 mm up to 4.6 %, the
-# explorer's nearest knee design up to 3.5 %; measured
-# with `benchmarks/path_convergence.py --strain-levels`, see the README's mesh-convergence table), so by a factor
-# of up to 1 / 0.951. The path's torques at a strain limit are multiplied by 0.95, and its strains at a load
+# higher torque than the default mesh, by a factor of up to 1 / 0.951 on the designs measured
+# (`benchmarks/path_convergence.py --strain-levels`; the table is in docs/validation/mesh-convergence.md). The path's torques at a strain limit are multiplied by 0.95, and its strains at a load
 # divided by it (the same statement to first order), so that a verdict read on the path mesh holds on the
 # default mesh (`tests/test_strain_knockdown.py`, marked default_mesh).
 STRAIN_TORQUE_KNOCKDOWN = 0.95

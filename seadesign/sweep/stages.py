@@ -44,7 +44,7 @@ class SolverSettings:
     linear_solver: str = "pardiso"  # "pardiso" or "scipy"
     path_layers: int = 1  # layers through the thickness of the large-deflection path's mesh (a prismatic part's):
     # its in-plane sizing is the result mesh's, which resolves the beam-root fillets where contact and
-    # creases start (README: a 2x coarser mesh put contact 11-26 % late)
+    # creases start; a coarser path mesh puts contact late (docs/validation/mesh-convergence.md)
     path_formulation: str = "full"  # volumetric formulation of the path (fea.finite_strain), as CalculiX's C3D10
     k_error_estimate: bool = True  # solve k on a COARSENING times coarser mesh too (k's discretization error,
     # `coarse_k`); the explorer, which judges designs on their paths, makes it only for the design it reports

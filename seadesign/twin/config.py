@@ -36,7 +36,8 @@ from seadesign.constants import G_M_PER_S2
 from seadesign.errors import ConfigError
 
 #: Coulomb friction of the gearbox in the servo's effort (Nm): the thesis's servo reports torque
-#: before it reaches the horn; 0.3 Nm is our estimate (DOMAIN.md), declared by the loop's robot model.
+#: before any torque reaches the horn (Stelter 2022, sec. 6.4, fig. 6.9: the servo must first overcome the
+#: gearbox friction); 0.3 Nm is our estimate, declared by the loop's robot model.
 GEAR_COULOMB_NM = 0.3
 
 
