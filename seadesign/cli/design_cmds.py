@@ -1,4 +1,4 @@
-"""Design-side subcommands: geometry, export, sweep."""
+"""Design-side subcommands: geometry, export."""
 
 from __future__ import annotations
 
@@ -20,7 +20,8 @@ TOL_OPT = click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0
 @main.command()
 @STUDY_ARG
 def geometry(study: str) -> None:
-    """List every candidate of STUDY (name in studies/ or a path): valid or not, why, volume and mass.
+    """List every candidate of STUDY (a name: NAME.toml here, else the packaged study; or a path): valid or not,
+    why, volume and mass.
 
     Volume in mm^3, mass in g (from the candidate material's density).
     """
@@ -52,4 +53,5 @@ def export(study: str, beams: int | None, thickness_mm: float | None, param: tup
         raise click.UsageError(f"candidate {c.name} is invalid: {'; '.join(c.reasons)}")
     for path in export_candidate(c, part, out_dir / s.name, tolerance_mm):
         click.echo(f"wrote {path}")
+
 
