@@ -1,5 +1,5 @@
 """Study and material files: packaged with seadesign, a working-directory file or a path taking precedence,
-the files used recorded with their hashes."""
+the files used recorded with their hashes, and `seadesign init`'s files to start from."""
 
 from __future__ import annotations
 
@@ -62,3 +62,23 @@ def test_an_unknown_name_lists_both_places(tmp_path, monkeypatch):
     with pytest.raises(ConfigError, match=r"material file .*nosuch\.toml not found; check the path"):
         load_material(tmp_path / "nosuch.toml")
 
+
+def test_init_writes_files_to_start_from_that_commands_there_read_first(tmp_path, monkeypatch):
+    runner = CliRunner()
+    result = runner.invoke(main, ["init", str(tmp_path / "knee")])
+    assert result.exit_code == 0, result.output
+    study, material = tmp_path / "knee" / "wolfgang_knee.toml", tmp_path / "knee" / "ninjaflex.toml"
+    assert study.read_text().startswith("# A study to start from, written by `seadesign init`")
+    assert study.read_text().endswith(DEFAULT_STUDY.read_text())
+    assert material.read_text().endswith((MATERIAL.packaged / "ninjaflex.toml").read_text())
+    again = runner.invoke(main, ["init", str(tmp_path / "knee")])
+    assert again.exit_code == 2 and f"{study} and {material} already exist" in again.output
+    assert "--force" in again.output and "Traceback" not in again.output
+    study.write_text(study.read_text().replace("beam_count = [3, 4, 5, 6, 7, 8, 9, 10]", "beam_count = [3, 4]"))
+    material.write_text(material.read_text().replace('name = "NinjaFlex TPU 85A"', 'name = "My TPU"'))
+    monkeypatch.chdir(tmp_path / "knee")
+    listed = runner.invoke(main, ["geometry", "wolfgang_knee"])
+    assert listed.exit_code == 0, listed.output
+    assert listed.output.startswith("study wolfgang_knee: 6 candidates, material My TPU\n")
+    forced = runner.invoke(main, ["init", "--force"])
+    assert forced.exit_code == 0 and "beam_count = [3, 4, 5, 6, 7, 8, 9, 10]" in study.read_text()

@@ -1,4 +1,4 @@
-"""Design-side subcommands: geometry, export."""
+"""Design-side subcommands: init, geometry, export."""
 
 from __future__ import annotations
 
@@ -55,3 +55,15 @@ def export(study: str, beams: int | None, thickness_mm: float | None, param: tup
         click.echo(f"wrote {path}")
 
 
+
+@main.command()
+@click.argument("folder", type=click.Path(file_okay=False, path_type=Path), default=Path("."), required=False)
+@click.option("--force", is_flag=True, help="Overwrite the files if they exist.")
+def init(folder: Path, force: bool) -> None:
+    """Write a study and a material to start from into FOLDER (default: here), commented copies of the
+    packaged default study and its material. Run from FOLDER, commands read them before the packaged files."""
+    from seadesign.design.starter import write_starters
+
+    study, material = write_starters(folder, force)
+    click.echo(f"wrote {study} (study) and {material} (material); edit them, then run "
+               f"`seadesign geometry {study.stem}` in {folder}")
