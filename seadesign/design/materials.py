@@ -1,4 +1,5 @@
-"""Material files (`materials/*.toml`, packaged with seadesign; see `inputs.py`): loading, unit conversion to SI, validation.
+"""Material files (`materials/*.toml`, packaged with seadesign; see `inputs.py`): loading, unit conversion to SI,
+validation.
 
 Each property is a table `{ value = ..., unit = "...", source = "..." }`; the loader converts
 to SI (Pa, kg/m^3, 1/Pa, strain as a fraction) and rejects anything missing, non-numeric or

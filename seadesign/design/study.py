@@ -1,5 +1,5 @@
-"""Study files (`studies/*.toml`, packaged with seadesign; see `inputs.py`): the design space, fixed geometry, material, load cases,
-robot/actuator data, mesh and ranking settings of one design problem.
+"""Study files (`studies/*.toml`, packaged with seadesign; see `inputs.py`): the design space, fixed geometry,
+material, load cases, robot/actuator data, mesh and ranking settings of one design problem.
 
 `[design_space]` names the axes (any numeric geometry key, see `space.py`), `[geometry]` the fixed
 values; each candidate's merged geometry is checked when the study loads.
