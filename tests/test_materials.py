@@ -5,7 +5,8 @@ from pathlib import Path
 import pytest
 
 from seadesign.errors import ConfigError
-from seadesign.design.materials import MATERIALS_DIR, load_material, load_material_file
+from seadesign.design.inputs import MATERIAL
+from seadesign.design.materials import load_material, load_material_file
 
 GOOD = """
 name = "Test TPU"
@@ -18,7 +19,7 @@ tensile_strength = { value = 26.0, unit = "MPa", source = "test" }
 
 
 def test_shipped_materials_load_in_si():
-    names = sorted(p.stem for p in MATERIALS_DIR.glob("*.toml"))
+    names = sorted(p.stem for p in MATERIAL.packaged.glob("*.toml"))
     assert {"ninjaflex", "cheetah", "pla", "brass", "generic_tpu"} <= set(names)
     nf = load_material("ninjaflex")
     assert nf.youngs_modulus_Pa == pytest.approx(12e6)
@@ -60,7 +61,7 @@ def test_bad_material_files_are_refused(tmp_path, edit, message):
 
 
 def test_unknown_material_lists_known():
-    with pytest.raises(ConfigError, match="known materials: .*ninjaflex"):
+    with pytest.raises(ConfigError, match="nor among the packaged materials in .*ninjaflex"):
         load_material("unobtainium")
 
 

@@ -64,7 +64,7 @@ def test_bad_study_is_refused_naming_the_key(tmp_path, old, new, message):
 
 
 def test_unknown_study_lists_known():
-    with pytest.raises(ConfigError, match="known studies: .*wolfgang_knee"):
+    with pytest.raises(ConfigError, match="nor among the packaged studies in .*wolfgang_knee"):
         load_study("nonexistent_study")
 
 

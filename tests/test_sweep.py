@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 
@@ -13,6 +14,7 @@ from click.testing import CliRunner
 from seadesign.run.cache import Cache
 from seadesign.cli import main
 from seadesign.errors import MeshError, SpringFileError
+from seadesign.design.inputs import MATERIAL
 from seadesign.design.spring import TorqueCurve, load_spring, validate_spring
 from seadesign.design.study import load_study
 from seadesign.sweep.runner import run_sweep
@@ -49,6 +51,10 @@ def test_outputs_exist_and_choice_is_the_valid_candidate(tiny):
     assert "<img" in html and "src='data:image/png;base64," in html and ".png'" not in html
     settings = json.loads((folder / "settings.json").read_text())
     assert "numpy" in settings["versions"]
+    study, nf = settings["files"]["study"], settings["files"]["materials"]["ninjaflex"]
+    assert study["path"] == str(tiny[0]) and study["sha256"] == hashlib.sha256(tiny[0].read_bytes()).hexdigest()
+    assert nf["path"] == str(MATERIAL.packaged / "ninjaflex.toml")
+    assert f"material ninjaflex {nf['path']} (sha256 {nf['sha256']})" in (folder / "report.md").read_text()
 
 
 def test_sweep_report_opens_with_the_decision_in_a_browser(tiny):

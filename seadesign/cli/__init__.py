@@ -16,7 +16,8 @@ from seadesign.errors import SeadesignError
 # Subcommand modules register themselves on `main` when imported; each is imported only when one
 # of its commands runs (or for the command list), so `seadesign sweep` does not load torch.
 COMMAND_MODULES = {
-    "geometry": "design_cmds", "export": "design_cmds", "solve": "fea_cmds", "sweep": "sweep_cmds", "explore": "explore_cmds",
+    "init": "design_cmds", "geometry": "design_cmds", "export": "design_cmds",
+    "solve": "fea_cmds", "sweep": "sweep_cmds", "explore": "explore_cmds",
     "data": "data_cmds", "simulate": "data_cmds", "simulate-bench": "data_cmds", "effects": "data_cmds",
     "train": "corrector_cmds", "evaluate": "corrector_cmds", "iterate": "corrector_cmds",
     "explain": "loop_cmds", "explain-thesis": "loop_cmds",

@@ -1,4 +1,4 @@
-"""Design-side subcommands: geometry, export, sweep."""
+"""Design-side subcommands: init, geometry, export."""
 
 from __future__ import annotations
 
@@ -20,7 +20,8 @@ TOL_OPT = click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0
 @main.command()
 @STUDY_ARG
 def geometry(study: str) -> None:
-    """List every candidate of STUDY (name in studies/ or a path): valid or not, why, volume and mass.
+    """List every candidate of STUDY (a name: NAME.toml here, else the packaged study; or a path): valid or not,
+    why, volume and mass.
 
     Volume in mm^3, mass in g (from the candidate material's density).
     """
@@ -53,3 +54,16 @@ def export(study: str, beams: int | None, thickness_mm: float | None, param: tup
     for path in export_candidate(c, part, out_dir / s.name, tolerance_mm):
         click.echo(f"wrote {path}")
 
+
+
+@main.command()
+@click.argument("folder", type=click.Path(file_okay=False, path_type=Path), default=Path("."), required=False)
+@click.option("--force", is_flag=True, help="Overwrite the files if they exist.")
+def init(folder: Path, force: bool) -> None:
+    """Write a study and a material to start from into FOLDER (default: here), commented copies of the
+    packaged default study and its material. Run from FOLDER, commands read them before the packaged files."""
+    from seadesign.design.starter import write_starters
+
+    study, material = write_starters(folder, force)
+    click.echo(f"wrote {study} (study) and {material} (material); edit them, then run "
+               f"`seadesign geometry {study.stem}` in {folder}")

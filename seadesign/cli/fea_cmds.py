@@ -38,7 +38,7 @@ SUMMARY = (
 @click.option("--stl", "stl", type=click.Path(dir_okay=False, path_type=Path), help="Solve this STL (mm) instead.")
 @click.option("--axis", type=click.Choice(["x", "y", "z"]), default="y", show_default=True, help="STL spring axis.")
 @click.option("--beam-width-mm", type=float, help="STL: beam width that sets the mesh size.")
-@click.option("--material", help="Material name (materials/NAME.toml); default: the study's, ninjaflex for --stl.")
+@click.option("--material", help="Material: a name (NAME.toml here, else the packaged one) or a path; default: the study's, ninjaflex for --stl.")
 @click.option("--material-E-Pa", "youngs", type=float, help="Override Young's modulus (Pa).")
 @click.option("--material-nu", "nu", type=float, help="Override Poisson ratio.")
 @click.option("--material-yield-Pa", "yield_", type=float, help="Override yield strength (Pa).")

@@ -1,4 +1,5 @@
-"""Material files (`materials/*.toml`): loading, unit conversion to SI, validation.
+"""Material files (`materials/*.toml`, packaged with seadesign; see `inputs.py`): loading, unit conversion to SI,
+validation.
 
 Each property is a table `{ value = ..., unit = "...", source = "..." }`; the loader converts
 to SI (Pa, kg/m^3, 1/Pa, strain as a fraction) and rejects anything missing, non-numeric or
@@ -17,9 +18,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from seadesign.design.tomlcheck import Table, find_toml, read_toml
-
-MATERIALS_DIR = Path(__file__).resolve().parents[2] / "materials"
+from seadesign.design.inputs import MATERIAL
+from seadesign.design.tomlcheck import Table, read_toml
 
 _TO_PA = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
 _TO_KG_M3 = {"kg/m^3": 1.0, "kg/m3": 1.0, "g/cc": 1000.0, "g/cm^3": 1000.0, "g/cm3": 1000.0}
@@ -209,6 +209,6 @@ def load_material_file(path: str | Path) -> Material:
     )
 
 
-def load_material(name_or_path: str | Path, materials_dir: Path = MATERIALS_DIR) -> Material:
-    """Load a material by file stem (e.g. "ninjaflex") from `materials/`, or by path."""
-    return load_material_file(find_toml(name_or_path, materials_dir, "material", "materials"))
+def load_material(name_or_path: str | Path) -> Material:
+    """Load a material by name (e.g. "ninjaflex": the working directory's file, else the packaged one) or by path."""
+    return load_material_file(MATERIAL.find(name_or_path))

@@ -1,5 +1,5 @@
-"""Study files (`studies/*.toml`): the design space, fixed geometry, material, load cases,
-robot/actuator data, mesh and ranking settings of one design problem.
+"""Study files (`studies/*.toml`, packaged with seadesign; see `inputs.py`): the design space, fixed geometry,
+material, load cases, robot/actuator data, mesh and ranking settings of one design problem.
 
 `[design_space]` names the axes (any numeric geometry key, see `space.py`), `[geometry]` the fixed
 values; each candidate's merged geometry is checked when the study loads.
@@ -19,18 +19,18 @@ from typing import TYPE_CHECKING
 
 from seadesign.constants import G_M_PER_S2
 from seadesign.design.candidate import Candidate, check_candidate
-from seadesign.design.materials import Material, load_material
+from seadesign.design.inputs import MATERIAL, STUDY, InputFile, StudyFiles
+from seadesign.design.materials import Material, load_material_file
 from seadesign.design.params import ValidityRules, read_geometry
 from seadesign.design.requirements import KWindow, Requirements, check_window, k_window, read_requirements, refuse_moved_keys
 from seadesign.design.space import MATERIAL_KEY, Axis, Value, grid, merged, read_axes
-from seadesign.design.tomlcheck import Table, find_toml, read_toml
+from seadesign.design.tomlcheck import Table, read_toml
 from seadesign.errors import ConfigError
 
 if TYPE_CHECKING:
     from seadesign.design.geometry import Part
 
-STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
-DEFAULT_STUDY = STUDIES_DIR / "wolfgang_knee.toml"
+DEFAULT_STUDY = STUDY.packaged / "wolfgang_knee.toml"
 
 
 @dataclass(frozen=True)
@@ -123,6 +123,7 @@ class Study:
     ranking: Ranking
     bearing_radius_mm: float  # where the stall displacement is read (thesis eq. 5.3)
     requirements: Requirements
+    files: StudyFiles  # the study and material files read, with their hashes
 
     @property
     def strike_speed_rad_per_s(self) -> float:
@@ -202,20 +203,21 @@ def _impact_lever(lc: Table, robot: Robot) -> float:
     return robot.lower_leg_m
 
 
-def _materials(top: Table, axes: tuple[Axis, ...]) -> dict[str, Material]:
-    """The fixed material (top-level `material`), or each value of a `material` design axis."""
+def _materials(top: Table, axes: tuple[Axis, ...]) -> tuple[dict[str, Material], dict[str, InputFile]]:
+    """The fixed material (top-level `material`), or each value of a `material` design axis, and their files."""
     axis = next((a for a in axes if a.key == MATERIAL_KEY), None)
     if axis is not None and "material" in top.data:
         raise top.error("material", "is also a design axis (design_space.material); a key is either a design axis "
                                     "or a fixed value: remove one of them")
     names, where = (axis.values, "design_space.material") if axis else ((top.string("material"),), "material")
-    materials = {}
+    materials, files = {}, {}
     for name in names:
         try:
-            materials[name] = load_material(name)
+            path = MATERIAL.find(name)
+            materials[name], files[name] = load_material_file(path), InputFile.of(path)
         except ConfigError as exc:
             raise top.error(where, f"cannot be loaded: {exc}") from None
-    return materials
+    return materials, files
 
 
 def _validity(top: Table) -> ValidityRules:
@@ -285,8 +287,8 @@ def _ranking(top: Table) -> tuple[Ranking, Requirements]:
 
 
 def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
-    """Load and validate a study by path or by name (a file stem in `studies/`)."""
-    path = find_toml(path, STUDIES_DIR, "study", "studies")
+    """Load and validate a study by path or by name (the working directory's NAME.toml, else the packaged one)."""
+    path = STUDY.find(path)
     top = Table(read_toml(path), path)
     name = top.string("name")
     description = top.string("description")
@@ -297,8 +299,10 @@ def load_study(path: str | Path = DEFAULT_STUDY) -> Study:
     axes = read_axes(top.table("design_space"), fixed)
     robot = _robot(top)
     ranking, requirements = _ranking(top)
-    study = Study(name, description, path, _materials(top, axes), axes, fixed, _validity(top),
-                  _load_cases(top, robot), robot, _actuator(top), _mesh(top), ranking, bearing_radius_mm, requirements)
+    materials, material_files = _materials(top, axes)
+    study = Study(name, description, path, materials, axes, fixed, _validity(top), _load_cases(top, robot), robot,
+                  _actuator(top), _mesh(top), ranking, bearing_radius_mm, requirements,
+                  StudyFiles(InputFile.of(path), material_files))
     top.done()
     check_window(study.k_window, str(path))
     if all(not a.continuous for a in axes):

@@ -25,17 +25,6 @@ def read_toml(path: Path) -> dict[str, Any]:
         raise ConfigError(f"{path}: not valid TOML ({exc})") from None
 
 
-def find_toml(name_or_path: str | Path, folder: Path, kind: str, kinds: str) -> Path:
-    """A config file by path, or by file stem in `folder`; unknown names list the known ones."""
-    path = Path(name_or_path)
-    if path.suffix != ".toml":
-        path = folder / f"{name_or_path}.toml"
-    if not path.exists():
-        known = ", ".join(sorted(p.stem for p in folder.glob("*.toml")))
-        raise ConfigError(f"{kind} '{name_or_path}' not found ({path}); known {kinds}: {known}")
-    return path
-
-
 class Table:
     """A TOML table read key by key; `done()` rejects keys nobody asked for."""
 

@@ -132,7 +132,8 @@ def write_exploration(study: Study, problem, exploration: Exploration, decision:
         sections=[("Study", study_text(study)), ("Objectives", objectives_text(study)),
                   ("Surrogate leave-one-out error", "; ".join(
                       f"{r['output']}: {fmt(r['mean |error| (%)'])} % mean, {fmt(r['largest |error| (%)'])} % largest "
-                      f"over {r['designs']} designs" for _, r in loo_table(exploration, problem.outputs).iterrows()))],
+                      f"over {r['designs']} designs" for _, r in loo_table(exploration, problem.outputs).iterrows())),
+                  ("Input files", study.files.describe())],
         details=[("Every evaluated design (full table)", compact_table(t.sort_values(objective), [(k, k) for k in keys])),
                  ("Rounds", pd.DataFrame([asdict(r) for r in exploration.rounds])),
                  ("Settings and versions", ", ".join(f"{k}: {v}" for k, v in settings.items()))],

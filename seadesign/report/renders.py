@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import logging
+import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +12,14 @@ import numpy as np
 log = logging.getLogger(__name__)
 COLOUR_PERCENTILE = 99.0  # the colour scale ends at this percentile of the vertex strain (a fillet's peak would
 # otherwise squeeze the rest of the part into one colour); above it: red
+VTK_WINDOW_ENV = "VTK_DEFAULT_OPENGL_WINDOW"  # the render window class VTK creates (VTK >= 9.4)
+
+
+def use_headless_window() -> None:
+    """Without a display, VTK tries an X window first, prints "bad X server connection" and only then falls back
+    to EGL: on Linux without DISPLAY, ask for the EGL window directly (unless VTK_DEFAULT_OPENGL_WINDOW is set)."""
+    if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+        os.environ.setdefault(VTK_WINDOW_ENV, "vtkEGLRenderWindow")
 
 
 def render_path(path_response, strain_limit: float, title: str, path: Path) -> Path | None:
@@ -20,7 +30,7 @@ def render_path(path_response, strain_limit: float, title: str, path: Path) -> P
     try:
         import pyvista as pv
 
-        pv.OFF_SCREEN = True
+        use_headless_window()
         r = path_response
         cells = np.hstack([np.full((len(r.tets), 1), 4), r.tets]).ravel()
         grid = pv.UnstructuredGrid(cells, np.full(len(r.tets), pv.CellType.TETRA, dtype=np.uint8),

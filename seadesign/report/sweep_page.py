@@ -103,7 +103,8 @@ def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: 
         table=compact_table(ranked, [("rank", "rank")]),
         table_caption=f"Ranked candidates (the first {len(ranked)})",
         figures=figures, renders=renders,
-        sections=[("Study", study_text(study)), ("Objectives", objectives_text(study)), ("Linear model", LINEAR_NOTE)],
+        sections=[("Study", study_text(study)), ("Objectives", objectives_text(study)), ("Linear model", LINEAR_NOTE),
+                  ("Input files", study.files.describe())],
         details=[("All candidates (full table)", summary_table(t)),
                  ("Settings and versions", ", ".join(f"{k}: {v}" for k, v in settings.items()))],
     )

@@ -185,6 +185,6 @@ def sweep_settings(study: Study, settings: SolverSettings) -> dict:
     """Settings and versions recorded next to the results."""
     from dataclasses import asdict
 
-    return {"study": study.name, "study_file": str(study.path),
+    return {"study": study.name, "files": asdict(study.files),
             "materials": {k: asdict(m) for k, m in study.materials.items()}, "mesh": asdict(study.mesh),
             "solver": asdict(settings), "ranking": asdict(study.ranking), "versions": package_versions()}
