@@ -45,15 +45,11 @@ def export(study: str, beams: int | None, thickness_mm: float | None, param: tup
            out_dir: Path) -> None:
     """Write STL and STEP (mm) of one valid candidate of STUDY to OUT/<study>/ (the candidate by its
     design-axis values: --param KEY=VALUE, or --beams N --thickness-mm T)."""
-    from seadesign.design.export import export_candidate
+    from seadesign.api import export as export_design
 
     s = load_study(study)
-    c, part = s.check(pick_candidate(s, beams, thickness_mm, param))
-    if not c.valid:
-        raise click.UsageError(f"candidate {c.name} is invalid: {'; '.join(c.reasons)}")
-    for path in export_candidate(c, part, out_dir / s.name, tolerance_mm):
+    for path in export_design(s, pick_candidate(s, beams, thickness_mm, param), out_dir, tolerance_mm):
         click.echo(f"wrote {path}")
-
 
 
 @main.command()

@@ -19,7 +19,13 @@ from typing import Any
 
 from seadesign.run.atomic import atomic_write
 
-DEFAULT_CACHE_DIR = Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
+
+def _default_cache_dir() -> Path:
+    """$SEADESIGN_CACHE as set now, else ~/.cache/seadesign."""
+    return Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
+
+
+DEFAULT_CACHE_DIR = _default_cache_dir()  # as set when this module was imported; `default_cache` reads it again
 TRACKED_PACKAGES = ("seadesign", "numpy", "scipy", "cadquery", "gmsh", "pytetwild", "mkl")
 
 
@@ -79,3 +85,24 @@ class Cache:
         if not self.enabled:
             return
         atomic_write(self.path(stage, key), lambda tmp: tmp.write_bytes(pickle.dumps(value, pickle.HIGHEST_PROTOCOL)))
+
+
+def default_cache(cache_dir: str | Path | None = None) -> Cache:
+    """The stage cache the commands use.
+
+    Parameters
+    ----------
+    cache_dir : str or Path, optional
+        Its folder; None: $SEADESIGN_CACHE as set now, else ~/.cache/seadesign.
+
+    Returns
+    -------
+    Cache
+        An enabled cache rooted there.
+
+    Examples
+    --------
+    >>> default_cache("/tmp/seadesign-cache").root
+    PosixPath('/tmp/seadesign-cache')
+    """
+    return Cache(Path(cache_dir) if cache_dir else _default_cache_dir())
