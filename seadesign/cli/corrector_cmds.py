@@ -15,12 +15,14 @@ from seadesign.corrector.train import TrainConfig
 from seadesign.corrector.workflow import DEFAULT_HISTORY, PREVIEW_MODELS
 from seadesign.design.spring import load_spring
 
+
 def _models(text: str) -> list[str]:
     models = [m.strip() for m in text.split(",") if m.strip()]
     bad = [m for m in models if m not in TRAIN_KINDS]
     if bad or not models:
         raise click.BadParameter(f"unknown model(s) {bad}; choose from {', '.join(TRAIN_KINDS)} (comma-separated)")
     return models
+
 
 @main.command()
 @click.option("--spring", "spring_path", required=True, type=click.Path(dir_okay=False),
@@ -67,6 +69,7 @@ def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: 
                      max_epochs=max_epochs, patience=patience, max_seconds=max_seconds, batch_size=batch_size, lr=lr,
                      out=out, echo=click.echo)
 
+
 @main.command()
 @click.argument("bundles", nargs=-1, required=True, type=click.Path(exists=True, file_okay=False))
 @click.option("--data", "data", multiple=True, type=click.Path(exists=True, dir_okay=False),
@@ -101,6 +104,7 @@ def evaluate(bundles: tuple[str, ...], data: tuple[str, ...], json_path: str | N
                        f"margin {r['modulus_margin']:.2f}  {'stable' if r['stable'] else 'NOT stable: ' + flags}")
     for f in res["files"]:
         click.echo(f"wrote {f}")
+
 
 @main.command()
 @click.option("--spring", "spring_path", required=True, type=click.Path(dir_okay=False), help="spring.json")
