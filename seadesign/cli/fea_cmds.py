@@ -10,7 +10,7 @@ from seadesign.cli import main
 from seadesign.cli.candidate_options import candidate_options, pick_candidate
 from seadesign.errors import ConfigError
 
-SUMMARY = (
+_SUMMARY = (
     ("k_Nm_per_rad", "spring constant k", "Nm/rad"),
     ("stall_rotation_rad", "stall: hub rotation", "rad"),
     ("stall_bearing_displacement_mm", "stall: max displacement on the bearing circle", "mm"),
@@ -86,7 +86,7 @@ def solve(study, beams, thickness_mm, param, stl, axis, beam_width_mm, material,
     click.echo(f"{solved.name}: {solved.material.name}, mesh {solved.backend} at {solved.elements_across_beam:g} "
                f"elements across {solved.beam_width_mm:g} mm"
                + (f", {per_circle:g} per turn on curved surfaces" if per_circle else ""))
-    for key, label, unit in SUMMARY:
+    for key, label, unit in _SUMMARY:
         click.echo(f"  {label:<52} {solved.results[key]:>12.5g} {unit}")
     click.echo(f"written: {out_dir / (solved.name + '.json')}, {out_dir / (solved.name + '.vtu')}")
     if ccx_dir is not None:

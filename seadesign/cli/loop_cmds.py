@@ -15,14 +15,14 @@ from seadesign.constants import THESIS_K_MEASURED_NM_PER_RAD
 from seadesign.loop.thesis import K_FEA_NM_PER_RAD, worked_example
 
 #: older role names the generic table's --signal still accepts (the loop's vocabulary is the effect library's)
-ROLE_ALIASES = {"displacement": "deflection"}
+_ROLE_ALIASES = {"displacement": "deflection"}
 
 
 def _pairs(items: tuple[str, ...], option: str) -> dict[str, str]:
     out = {}
     for item in items:
         role, eq, col = item.partition("=")
-        role = ROLE_ALIASES.get(role, role)
+        role = _ROLE_ALIASES.get(role, role)
         if not eq or not col:
             raise ConfigError(f"{option} '{item}' must be ROLE=VALUE, e.g. deflection=deflection_rad")
         if option == "--signal" and role not in ROLES:

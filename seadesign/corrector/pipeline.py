@@ -50,7 +50,18 @@ class TrainedCorrector:
     summary: str
 
     def line(self) -> str:
-        """The line `seadesign train` prints for it: ``NAME: SUMMARY -> BUNDLE``."""
+        """The line `seadesign train` prints for it.
+
+        Returns
+        -------
+        str
+            ``NAME: SUMMARY -> BUNDLE``.
+
+        Examples
+        --------
+        >>> TrainedCorrector("mlp", Path("b"), "best validation MSE 0.01 rad^2").line()
+        'mlp: best validation MSE 0.01 rad^2 -> b'
+        """
         return f"{self.name}: {self.summary} -> {self.bundle}"
 
 

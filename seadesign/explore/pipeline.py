@@ -175,7 +175,9 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
 
     Examples
     --------
-    >>> result = run_exploration("wolfgang_knee", budget=12, jobs=2, quiet=True)
+    >>> import seadesign as sd
+    >>> result = sd.run_exploration("wolfgang_knee", budget=12, jobs=2, quiet=True)
+    >>> result.plot()
     """
     from seadesign.errors import ConfigError
     from seadesign.explore.loop import LoopSettings

@@ -55,7 +55,8 @@ def apply_calibration(study: Study, path: str | Path) -> tuple[Study, str]:
 
     Examples
     --------
-    >>> calibrated, note = apply_calibration(load_study("wolfgang_knee"), "thesis_calibration.json")
+    >>> import seadesign as sd
+    >>> calibrated, note = sd.apply_calibration(sd.load_study(), "thesis_calibration.json")
     """
     try:
         data = json.loads(Path(path).read_text())
@@ -178,8 +179,8 @@ class SweepResult:
         solved = self.ranked[self.ranked["status"] == "ok"]
         for index, row in solved.iterrows():
             chosen = index == self.choice.index
-            line, = ax.plot(row["large_curve_rotation_rad"], row["large_curve_torque_Nm"], "-", lw=2.0 if chosen else 0.9,
-                            label=f"{row['candidate']}{' (chosen)' if chosen else ''}")
+            line, = ax.plot(row["large_curve_rotation_rad"], row["large_curve_torque_Nm"], "-",
+                            lw=2.0 if chosen else 0.9, label=f"{row['candidate']}{' (chosen)' if chosen else ''}")
             ax.plot(row["large_stop_rotation_rad"], row["large_stop_torque_Nm"], "x", color=line.get_color())
         lc = self.study.load_cases
         for torque_Nm, name in ((lc.stall_torque_Nm, "stall"), (lc.impact_torque_Nm, "impact")):

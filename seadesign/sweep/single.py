@@ -149,8 +149,9 @@ def solve_candidate(study: Study, candidate: Candidate, *, out_dir: str | Path |
 
     Examples
     --------
-    >>> study = load_study("wolfgang_knee")
-    >>> solve_candidate(study, study.candidate(3, 8.0)).k_Nm_per_rad
+    >>> import seadesign as sd
+    >>> study = sd.load_study("wolfgang_knee")
+    >>> sd.solve(study, study.candidate(beam_count=3, beam_thickness_mm=8.0)).k_Nm_per_rad
     """
     from seadesign.design.materials import load_material
 
@@ -220,7 +221,8 @@ def solve_stl(stl: str | Path, beam_width_mm: float, *, study: Study | None = No
 
     Examples
     --------
-    >>> solve_stl("spring.stl", beam_width_mm=8.0).k_Nm_per_rad
+    >>> import seadesign as sd
+    >>> sd.solve_stl("spring.stl", beam_width_mm=8.0).k_Nm_per_rad
     """
     from seadesign.design.materials import load_material
     from seadesign.design.study import load_study
@@ -362,8 +364,10 @@ def candidate_path(study: Study, candidate: Candidate, *, settings: SolverSettin
 
     Examples
     --------
-    >>> path = candidate_path(study, study.candidate(3, 8.0))
-    >>> path.stop_reason
+    >>> import seadesign as sd
+    >>> study = sd.load_study("wolfgang_knee")
+    >>> path = sd.torque_path(study, study.candidate(beam_count=3, beam_thickness_mm=8.0))
+    >>> path.stop_reason, path.stop_torque_Nm
     """
     cache = cache or default_cache()
     checked, part = check_geometry(study, candidate, cache)
