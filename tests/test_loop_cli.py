@@ -64,7 +64,7 @@ def test_thesis_worked_example(tmp_path, spring_file):
     assert cal["parameters"]["dead_band"]["width_rad"]["value"] == pytest.approx(0.03, rel=0.027)
     assert cal["held_out_rmse_after"] < 3.5e-4 * cal["held_out_rmse_before"]
     # the scale is relative to the thesis FEA's material (generic TPU), so the sweep takes the fitted modulus
-    from seadesign.cli.sweep_cmds import apply_calibration
+    from seadesign.sweep.pipeline import apply_calibration
     from seadesign.design.materials import load_material
     from seadesign.design.study import load_study
 

@@ -187,7 +187,7 @@ def test_spring_schema_refuses_a_document_without_k(tiny):
 
 
 def test_calibration_scales_the_modulus(tmp_path):
-    from seadesign.cli.sweep_cmds import apply_calibration
+    from seadesign.sweep.pipeline import apply_calibration
     from seadesign.errors import ConfigError
 
     s = load_study(write_tiny_study(tmp_path))

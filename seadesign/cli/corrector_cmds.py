@@ -2,28 +2,18 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import click
 
 from seadesign.cli import main
-from seadesign.corrector.dataset import TASKS, DatasetSpec
-from seadesign.corrector.export import versions
-from seadesign.corrector.iterative import iterate as run_iterations
+from seadesign.corrector.dataset import TASKS
 from seadesign.corrector.models import MODEL_KINDS
-from seadesign.corrector.recordings import load_recordings
-from seadesign.corrector.report import write_table
-from seadesign.corrector.preflight import check_spring_range
-from seadesign.corrector.simcheck import check_simulator
+from seadesign.corrector.pipeline import TRAIN_KINDS, iterate_training
+from seadesign.corrector.pipeline import evaluate as evaluate_correctors
+from seadesign.corrector.pipeline import train as train_correctors
 from seadesign.corrector.splits import SPLITS
 from seadesign.corrector.train import TrainConfig
-from seadesign.corrector.workflow import (DEFAULT_HISTORY, PREVIEW_MODELS, candidate_name, evaluate_bundles,
-                                          train_bundle, train_closedloop_bundle, train_reference_bundle)
+from seadesign.corrector.workflow import DEFAULT_HISTORY, PREVIEW_MODELS
 from seadesign.design.spring import load_spring
-from seadesign.twin import thesis_protocol
-
-
-TRAIN_KINDS = (*PREVIEW_MODELS, *MODEL_KINDS)
 
 
 def _models(text: str) -> list[str]:
@@ -32,15 +22,6 @@ def _models(text: str) -> list[str]:
     if bad or not models:
         raise click.BadParameter(f"unknown model(s) {bad}; choose from {', '.join(TRAIN_KINDS)} (comma-separated)")
     return models
-
-
-def _echo_checks(checks: list) -> None:
-    """The simulator check's lines, and a warning when the robot's k is outside the tested range."""
-    for c in checks:
-        click.echo(("" if c.within_robust_range else "WARNING: ") + "simulator check: " + c.text())
-    if any(not c.within_robust_range for c in checks):
-        click.echo("WARNING: the robot's k is outside what this corrector was tested for; calibrate "
-                   "spring.json first (seadesign explain, then sweep --calibration)")
 
 
 @main.command()
@@ -80,48 +61,13 @@ def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: 
     """Train corrector network(s) and export bundles (TorchScript, ONNX, NumPy): by default the closed-loop corrector
     trained in the knee simulator built from spring.json; models on recordings with --model."""
     models = _models(model_text)
-    spring = load_spring(spring_path)
-    on_data = [m for m in models if m not in PREVIEW_MODELS]
-    if not data and on_data:
+    load_spring(spring_path)  # a bad spring.json is named before a missing --data
+    if not data and [m for m in models if m not in PREVIEW_MODELS]:
         raise click.BadParameter("models trained on recordings need --data FILE (repeat for several files)")
-    recs = load_recordings(list(data)) if on_data else []  # the preview models' simulator check reads the files
-    cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=max_seconds,
-                      batch_size=batch_size, lr=lr)
-    root = Path(out) if out else Path("exports") / spring["study"] / "corrector"
-    if set(models) & set(PREVIEW_MODELS):
-        check_spring_range(spring)  # refuses here, before any training, a curve that ends before the protocol's loads
-    checks = check_simulator(spring, list(data)) if set(models) & set(PREVIEW_MODELS) else []
-    _echo_checks(checks)
-    family1 = None
-    for model in sorted(models, key=lambda m: m != "reference"):  # family 1 first: family 2 fine-tunes it
-        if model in PREVIEW_MODELS:
-            folder = {"reference": "reference-ilc", "closedloop": "closedloop"}[model]
-            target = root if (out and len(models) == 1) else root / folder
-            if model == "reference":
-                path, family1, _ = train_reference_bundle(spring_path, target, data_paths=list(data), checks=checks)
-                s = family1.summary()["training"]
-                summary = (f"ILC labels {family1.label_s:.0f} s ({len(family1.labels)} batches); best validation MSE "
-                           f"{s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} ({s['stopped']}, "
-                           f"{s['wall_s']:.1f} s)")
-            else:
-                path, res, _ = train_closedloop_bundle(spring_path, target, family1=family1, data_paths=list(data),
-                                                       checks=checks)
-                s = res.summary()
-                summary = (f"fine-tuned through the closed loop: validation mean |Hall error| "
-                           f"{s['best_val_mean_abs_error_rad']:.4f} rad at epoch {s['best_epoch']} ({s['stopped']}, "
-                           f"{s['wall_s']:.1f} s); feedback gain bound {s['feedback_lipschitz_bound_rad_per_rad']:.3f} "
-                           "rad/rad")
-            click.echo(f"{model}: {summary} -> {path}")
-            continue
-        h = history if history is not None else (DEFAULT_HISTORY if model == "history" else 0)
-        spec = DatasetSpec(task, modalities, h, positive)
-        name = candidate_name(model, spec)
-        target = root if (out and len(models) == 1) else root / name
-        path, res = train_bundle(spring_path, list(data), model, spec, split_name, cfg, target,
-                                 list(test_recording) or None, recordings=recs)
-        s = res.summary()
-        click.echo(f"{name}: best validation MSE {s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} "
-                   f"({s['stopped']}, {s['wall_s']:.1f} s, {s['samples_per_s']:.0f} samples/s) -> {path}")
+    train_correctors(spring_path, tuple(models), data, modalities=modalities, task=task, positive=positive,
+                     history=history, split=split_name, test_recording=test_recording, seed=seed,
+                     max_epochs=max_epochs, patience=patience, max_seconds=max_seconds, batch_size=batch_size, lr=lr,
+                     out=out, echo=click.echo)
 
 
 @main.command()
@@ -142,7 +88,8 @@ def evaluate(bundles: tuple[str, ...], data: tuple[str, ...], json_path: str | N
     """Score corrector bundles against the baselines, open loop on recordings and closed loop in the
     knee simulator; write tables (CSV, Markdown[, JSON]) and plots."""
     settings = tuple(s.strip() for s in closed_loop.split(",") if s.strip() and s.strip() != "none")
-    res = evaluate_bundles(list(bundles), list(data), out, json_path, kp, ki, settings, trial_s)
+    res = evaluate_correctors(bundles, data, out=out, json_path=json_path, kp=kp, ki=ki, closed_loop=settings,
+                              trial_s=trial_s)
     both = [r for r in res.get("open_loop", []) if r["knee"] == "both"]
     if both:
         click.echo(f"open loop ({res['settings']['rows']}):")
@@ -179,17 +126,9 @@ def iterate(spring_path: str, data: tuple[str, ...], model: str, modalities: str
             history: int | None, rounds: int, setting: str, trial_s: float, seed: int, max_seconds: float,
             out: str | None) -> None:
     """Iterative training: retrain on simulator runs recorded with the current corrector in the loop."""
-    spring = load_spring(spring_path)
-    h = history if history is not None else (DEFAULT_HISTORY if model == "history" else 0)
-    spec = DatasetSpec(task, modalities, h, positive)
-    cfg = TrainConfig(model=model, seed=seed, max_seconds=max_seconds)
-    table, _ = run_iterations(spring, load_recordings(list(data)), spec, cfg, rounds, setting,
-                              thesis_protocol(trial_s), seed=seed)
-    folder = Path(out) if out else Path("exports") / spring["study"] / "corrector" / "iterative"
-    files = write_table(table, folder, "iterative", {"spec": spec.to_dict(), "training": cfg.__dict__,
-                                                    "setting": setting, "trial_s": trial_s,
-                                                    "data": [str(Path(d).resolve()) for d in data],
-                                                    "versions": versions()})
+    table, files = iterate_training(spring_path, data, model=model, modalities=modalities, task=task,
+                                    positive=positive, history=history, rounds=rounds, setting=setting,
+                                    trial_s=trial_s, seed=seed, max_seconds=max_seconds, out=out)
     for r in table.to_dict("records"):
         click.echo(f"round {r['round']}: mean |Hall error| {r['mean_abs_error_rad']:.4f} rad, peak "
                    f"{r['peak_abs_error_rad']:.3f} rad, unstable {r['unstable_flag']}, "

@@ -10,15 +10,15 @@ from seadesign.cli import main
 from seadesign.cli.candidate_options import candidate_options, pick_candidate
 from seadesign.design.study import DEFAULT_STUDY, load_study
 
-STUDY_ARG = click.argument("study", default=str(DEFAULT_STUDY.stem), required=False)
-OUT_OPT = click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=Path("exports"),
+_STUDY_ARG = click.argument("study", default=str(DEFAULT_STUDY.stem), required=False)
+_OUT_OPT = click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=Path("exports"),
                        show_default=True, help="Output root; files go to OUT/<study>/.")
-TOL_OPT = click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0), default=0.01, show_default=True,
+_TOL_OPT = click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0), default=0.01, show_default=True,
                        help="STL chordal tolerance in mm (max distance between triangles and the true surface).")
 
 
 @main.command()
-@STUDY_ARG
+@_STUDY_ARG
 def geometry(study: str) -> None:
     """List every candidate of STUDY (a name: NAME.toml here, else the packaged study; or a path): valid or not,
     why, volume and mass.
@@ -37,23 +37,19 @@ def geometry(study: str) -> None:
 
 
 @main.command()
-@STUDY_ARG
+@_STUDY_ARG
 @candidate_options
-@TOL_OPT
-@OUT_OPT
+@_TOL_OPT
+@_OUT_OPT
 def export(study: str, beams: int | None, thickness_mm: float | None, param: tuple[str, ...], tolerance_mm: float,
            out_dir: Path) -> None:
     """Write STL and STEP (mm) of one valid candidate of STUDY to OUT/<study>/ (the candidate by its
     design-axis values: --param KEY=VALUE, or --beams N --thickness-mm T)."""
-    from seadesign.design.export import export_candidate
+    from seadesign.api import export as export_design
 
     s = load_study(study)
-    c, part = s.check(pick_candidate(s, beams, thickness_mm, param))
-    if not c.valid:
-        raise click.UsageError(f"candidate {c.name} is invalid: {'; '.join(c.reasons)}")
-    for path in export_candidate(c, part, out_dir / s.name, tolerance_mm):
+    for path in export_design(s, pick_candidate(s, beams, thickness_mm, param), out_dir, tolerance_mm):
         click.echo(f"wrote {path}")
-
 
 
 @main.command()

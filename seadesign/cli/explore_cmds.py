@@ -57,33 +57,11 @@ def explore(study: str, budget: int, batch: int | None, seed: int, jobs: int | N
 
 def _explore(study: str, budget: int, batch: int | None, seed: int, jobs: int | None, quiet: bool, executor: str,
              scheduler: str | None, out_dir: Path, cache_dir: Path | None, tolerance_mm: float) -> None:
-    from seadesign.design.study import load_study
-    from seadesign.explore.loop import LoopSettings
-    from seadesign.explore.study_run import explore_study
-    from seadesign.report.exploration import headline, write_exploration
-    from seadesign.report.explore_plots import column_label
-    from seadesign.run.cache import DEFAULT_CACHE_DIR, Cache
-    from seadesign.run.executors import default_jobs
-    from seadesign.sweep.stages import SolverSettings
+    """The explore command's work (`explore.pipeline`; see `explore`)."""
+    from seadesign.explore.pipeline import run_exploration
 
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
-    s = load_study(study)
-    cache = Cache(cache_dir or DEFAULT_CACHE_DIR)
-    solver = SolverSettings()
-    folder = out_dir / s.name
-    loop = LoopSettings(budget=budget, batch=batch or jobs or default_jobs(), seed=seed)
-    run = explore_study(s, folder, loop, solver=solver, cache=cache, executor=executor, jobs=jobs, scheduler=scheduler,
-                        quiet=quiet)
-    written = write_exploration(s, run.problem, run.exploration, run.decision, run.sobol, folder, run.settings,
-                                solver=solver, cache=cache, tolerance_mm=tolerance_mm)
-    t, screened = run.exploration.evaluated, run.exploration.screened
-    click.echo(f"{len(t)} full-path evaluations, {len(screened)} screenings "
-               f"({int((~screened['valid'].astype(bool)).sum())} invalid), {run.wall_s:.1f} s; "
-               f"stop: {run.exploration.stop_reason}")
-    objective = run.problem.objectives[0]
-    click.echo(headline(t, run.decision, column_label(objective), objective))
-    click.echo(run.decision.predicted)
-    for paths in written.values():
-        for p in paths:
-            if not quiet:
-                click.echo(f"wrote {p}")
+    result = run_exploration(study, budget, batch=batch, seed=seed, jobs=jobs, quiet=quiet, executor=executor,
+                             scheduler=scheduler, out_dir=out_dir, cache_dir=cache_dir, tolerance_mm=tolerance_mm)
+    for line in result.lines(quiet):
+        click.echo(line)

@@ -10,7 +10,7 @@ from seadesign.cli import main
 from seadesign.cli.candidate_options import candidate_options, pick_candidate
 from seadesign.errors import ConfigError
 
-SUMMARY = (
+_SUMMARY = (
     ("k_Nm_per_rad", "spring constant k", "Nm/rad"),
     ("stall_rotation_rad", "stall: hub rotation", "rad"),
     ("stall_bearing_displacement_mm", "stall: max displacement on the bearing circle", "mm"),
@@ -61,54 +61,33 @@ def solve(study, beams, thickness_mm, param, stl, axis, beam_width_mm, material,
     Either STUDY and the candidate's design-axis values (--param KEY=VALUE, or --beams N
     --thickness-mm T), or --stl FILE --beam-width-mm W.
     """
-    from seadesign.fea.solve_part import solve_part
-    from seadesign.design.materials import load_material
     from seadesign.design.study import load_study
+    from seadesign.sweep.single import solve_candidate, solve_stl
 
     if (stl is None) == (study is None):
         raise ConfigError("give either a STUDY (with its candidate's axis values) or --stl FILE, not both or neither")
     st = load_study(study) if study is not None else load_study()
+    overrides = dict(youngs_modulus_Pa=youngs, poisson_ratio=nu, yield_strength_Pa=yield_,
+                     stall_torque_Nm=stall_torque_nm, impact_torque_Nm=impact_torque_nm,
+                     bearing_radius_mm=bearing_radius_mm, export_ccx_dir=ccx_dir)
     if stl is not None:
-        from seadesign.mesh import load_stl
-        from seadesign.mesh.detect import detect_interfaces
-
         if beam_width_mm is None:
             raise ConfigError("--stl needs --beam-width-mm (the beams' in-plane width sets the mesh size)")
-        geometry = load_stl(stl, axis)
-        interfaces = detect_interfaces(*geometry)
-        mat = load_material(material or "ninjaflex")
-        name, width = stl.stem, beam_width_mm
-        bearing = bearing_radius_mm or interfaces.hub_radius_mm
-        across, mesher = elements_across_beam or 3.0, backend or "pytetwild"
-        per_circle, layers = elements_per_circle or 0.0, 0
+        out_dir = out_dir or Path("exports") / stl.stem
+        solved = solve_stl(stl, beam_width_mm, study=st, axis=axis, out_dir=out_dir, material=material or "ninjaflex",
+                           elements_across_beam=elements_across_beam or 3.0, backend=backend or "pytetwild",
+                           elements_per_circle=elements_per_circle or 0.0, **overrides)
     else:
-        checked, part = st.check(pick_candidate(st, beams, thickness_mm, param))
-        if not checked.valid:
-            raise ConfigError(f"candidate {checked.name} is invalid: {'; '.join(checked.reasons)}")
-        geometry, interfaces = part.solid, part.interfaces
-        mat = load_material(material) if material else checked.material
-        name, width = checked.stem, checked.params.beam_thickness_mm
-        bearing = bearing_radius_mm or st.bearing_radius_mm
-        across = elements_across_beam or st.mesh.elements_across_beam
-        mesher = backend or st.mesh.backend
-        per_circle = elements_per_circle if elements_per_circle is not None else (
-            st.mesh.elements_per_circle if mesher == "gmsh" else 0.0)
-        layers = st.mesh.mesh_part_options()["layers"] if mesher == "gmsh" else 0
-    out_dir = out_dir or Path("exports") / (st.name if stl is None else stl.stem)
-    results, _, _ = solve_part(
-        geometry, interfaces,
-        youngs_modulus_Pa=youngs or mat.youngs_modulus_Pa,
-        poisson_ratio=nu if nu is not None else mat.poisson_ratio,
-        yield_strength_Pa=yield_ or mat.yield_strength_Pa,
-        stall_torque_Nm=stall_torque_nm or st.load_cases.stall_torque_Nm,
-        impact_torque_Nm=impact_torque_nm or st.load_cases.impact_torque_Nm,
-        bearing_radius_mm=bearing, elements_across_beam=across, beam_width_mm=width, backend=mesher,
-        elements_per_circle=per_circle, layers=layers, out_dir=out_dir, export_ccx_dir=ccx_dir, name=name,
-    )
-    click.echo(f"{name}: {mat.name}, mesh {mesher} at {across:g} elements across {width:g} mm"
+        out_dir = out_dir or Path("exports") / st.name
+        solved = solve_candidate(st, pick_candidate(st, beams, thickness_mm, param), out_dir=out_dir,
+                                 material=material, elements_across_beam=elements_across_beam,
+                                 elements_per_circle=elements_per_circle, backend=backend, **overrides)
+    per_circle = solved.elements_per_circle
+    click.echo(f"{solved.name}: {solved.material.name}, mesh {solved.backend} at {solved.elements_across_beam:g} "
+               f"elements across {solved.beam_width_mm:g} mm"
                + (f", {per_circle:g} per turn on curved surfaces" if per_circle else ""))
-    for key, label, unit in SUMMARY:
-        click.echo(f"  {label:<52} {results[key]:>12.5g} {unit}")
-    click.echo(f"written: {out_dir / (name + '.json')}, {out_dir / (name + '.vtu')}")
+    for key, label, unit in _SUMMARY:
+        click.echo(f"  {label:<52} {solved.results[key]:>12.5g} {unit}")
+    click.echo(f"written: {out_dir / (solved.name + '.json')}, {out_dir / (solved.name + '.vtu')}")
     if ccx_dir is not None:
         click.echo(f"CalculiX decks: {Path(ccx_dir) / 'stall.inp'}, {Path(ccx_dir) / 'impact.inp'} (run: ccx -i stall)")

@@ -5,43 +5,30 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import pandas as pd
 
 from seadesign.cli import main
-from seadesign.data import clean, is_hanging, read_bench, read_recording
 from seadesign.errors import ConfigError
 from seadesign.design.spring import load_spring
-from seadesign.loop import CANDIDATES, ROLES, explain, from_frame
-from seadesign.loop.report import write_report
-from seadesign.loop.sea import ROBOT_DECLARED, bench_loop_data, calibration, robot_declared, robot_loop_data
+from seadesign.loop import CANDIDATES, ROLES
+from seadesign.loop.explain_file import explain_file
 from seadesign.constants import THESIS_K_MEASURED_NM_PER_RAD
 from seadesign.loop.thesis import K_FEA_NM_PER_RAD, worked_example
 
 #: older role names the generic table's --signal still accepts (the loop's vocabulary is the effect library's)
-ROLE_ALIASES = {"displacement": "deflection"}
+_ROLE_ALIASES = {"displacement": "deflection"}
 
 
 def _pairs(items: tuple[str, ...], option: str) -> dict[str, str]:
     out = {}
     for item in items:
         role, eq, col = item.partition("=")
-        role = ROLE_ALIASES.get(role, role)
+        role = _ROLE_ALIASES.get(role, role)
         if not eq or not col:
             raise ConfigError(f"{option} '{item}' must be ROLE=VALUE, e.g. deflection=deflection_rad")
         if option == "--signal" and role not in ROLES:
             raise ConfigError(f"{option} '{item}': unknown role '{role}'; roles: {', '.join(ROLES)}")
         out[role] = col
     return out
-
-
-def _kind(path: Path) -> str:
-    header = pd.read_csv(path, nrows=0).columns
-    if "l_hall_pos" in header:
-        return "robot"
-    if "torque_Nm" in header and "deflection_rad" in header:
-        return "bench"
-    raise ConfigError(f"{path}: neither a bench file (time_s, torque_Nm, deflection_rad) nor a robot recording "
-                      "(l_hall_pos, ...); for another table give --measured, --predicted and --signal")
 
 
 @main.command("explain")
@@ -83,46 +70,14 @@ def explain_cmd(file: Path, spring_path: Path | None, json_out: Path | None, out
     FILE is a bench file or robot recording (with --spring), or any CSV table with --measured,
     --predicted and --signal ROLE=COLUMN.
     """
-    spring, declared, exclude = None, [], ()
-    if measured or predicted:
-        if not (measured and predicted):
-            raise ConfigError("a generic table needs both --measured and --predicted")
-        data = from_frame(pd.read_csv(file), measured, predicted, _pairs(signals, "--signal"),
-                          units=_pairs(units, "--unit"), measured_unit=measured_unit)
-        exclude, loop_plot, stem = tuple(declare), False, file.stem
-    else:
-        if spring_path is None:
-            raise ConfigError(f"{file}: bench and robot files need --spring PATH (spring.json with k)")
-        spring = load_spring(spring_path)
-        if _kind(file) == "bench":
-            data = bench_loop_data(read_bench(file), spring, predict)
-            loop_plot, stem = True, file.stem
-        else:
-            raw = read_recording(file)
-            keep = is_hanging(raw) if keep_lifted is None else keep_lifted
-            table = clean(raw, keep_lifted=keep, normalise=False, euler=False).table
-            data = robot_loop_data(table, spring, knee)
-            declared = [] if plain else robot_declared(spring, tuple(declare) or tuple(ROBOT_DECLARED))
-            loop_plot, stem = False, f"{file.stem}_{knee}"
-    out_dir = out_dir or Path("exports") / "explain" / stem
-    ex = explain(data, declared, exclude=exclude, min_gain=min_gain)
-    cal = calibration(ex, spring, str(file)) if spring is not None else None
-    paths = write_report(ex, out_dir, stem, f"Explain {file.name}", loop_plot=loop_plot, calibration=cal)
-    if json_out is not None:
-        json_out.parent.mkdir(parents=True, exist_ok=True)
-        json_out.write_text(paths["json"].read_text())
-    e0, e1 = ex.plain.errors, ex.final.errors
-    click.echo(ex.verdict())
-    click.echo(f"RMSE ({data.measured_unit}) train {e0['train']['rmse']:.4g} -> {e1['train']['rmse']:.4g}, "
-               f"held-out {e0['held_out']['rmse']:.4g} -> {e1['held_out']['rmse']:.4g}")
-    for check in ex.declared:
-        click.echo(f"  declared {check.text()}")
-    for key in ex.added:
-        ps = ex.final.parameters().get(key, {})
-        click.echo(f"  found {key}: " + ", ".join(f"{n} = {p['value']:.4g} +- {p['uncertainty']:.2g} {p['unit']}"
-                                                  for n, p in ps.items()))
-    for kind, path in paths.items():
-        click.echo(f"{kind}: {path}")
+    generic = bool(measured and predicted)  # one without the other: the library names what is missing
+    found = explain_file(file, spring_path, out_dir=out_dir, json_out=json_out, predict=predict, knee=knee,
+                         keep_lifted=keep_lifted, measured=measured, predicted=predicted,
+                         signals=_pairs(signals, "--signal") if generic else None,
+                         units=_pairs(units, "--unit") if generic else None, measured_unit=measured_unit,
+                         declare=declare, plain=plain, min_gain=min_gain)
+    for line in found.lines():
+        click.echo(line)
 
 
 @main.command("explain-thesis")

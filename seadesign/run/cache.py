@@ -19,7 +19,13 @@ from typing import Any
 
 from seadesign.run.atomic import atomic_write
 
-DEFAULT_CACHE_DIR = Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
+
+def _default_cache_dir() -> Path:
+    """$SEADESIGN_CACHE as set now, else ~/.cache/seadesign."""
+    return Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
+
+
+DEFAULT_CACHE_DIR = _default_cache_dir()  # as set when this module was imported; `default_cache` reads it again
 TRACKED_PACKAGES = ("seadesign", "numpy", "scipy", "cadquery", "gmsh", "pytetwild", "mkl")
 
 
@@ -39,13 +45,47 @@ def _plain(obj: Any) -> Any:
 
 
 def digest(*parts: Any, length: int = 32) -> str:
-    """Hex SHA-256 (first `length` characters) of the canonical JSON of `parts`."""
+    """Hex SHA-256 of the canonical JSON of `parts` (dataclasses by field, floats by repr: exact).
+
+    Parameters
+    ----------
+    *parts : Any
+        Everything a stage's output depends on.
+    length : int
+        Characters of the hex digest kept.
+
+    Returns
+    -------
+    str
+        The key.
+
+    Examples
+    --------
+    >>> digest("mesh", 1.5, length=8) == digest("mesh", 1.5, length=8)
+    True
+    """
     text = json.dumps(_plain(list(parts)), sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:length]
 
 
 def package_versions(packages: tuple[str, ...] = TRACKED_PACKAGES) -> dict[str, str]:
-    """Installed versions of `packages` ("absent" when not installed)."""
+    """Installed versions of third-party packages, part of the keys of the stages they compute.
+
+    Parameters
+    ----------
+    packages : tuple of str
+        Distribution names.
+
+    Returns
+    -------
+    dict of str to str
+        Name -> version ("absent" when not installed).
+
+    Examples
+    --------
+    >>> package_versions(("numpy",))["numpy"] != "absent"
+    True
+    """
     out = {}
     for name in packages:
         try:
@@ -63,10 +103,47 @@ class Cache:
     enabled: bool = True
 
     def path(self, stage: str, key: str) -> Path:
+        """Where the output of `stage` under `key` is stored.
+
+        Parameters
+        ----------
+        stage : str
+            The stage's name (geometry, fea, coarse_k, path).
+        key : str
+            Its key (`digest`).
+
+        Returns
+        -------
+        Path
+            ``root/<stage>/<key[:2]>/<key>.pkl``.
+
+        Examples
+        --------
+        >>> Cache(Path("/tmp/c")).path("fea", "abcd").as_posix()
+        '/tmp/c/fea/ab/abcd.pkl'
+        """
         return Path(self.root) / stage / key[:2] / f"{key}.pkl"
 
     def get(self, stage: str, key: str) -> Any | None:
-        """The stored output, or None when absent or unreadable (then it is recomputed)."""
+        """The stored output of a stage.
+
+        Parameters
+        ----------
+        stage : str
+            The stage's name.
+        key : str
+            Its key (`digest`).
+
+        Returns
+        -------
+        Any or None
+            The output, or None when absent, unreadable or the cache is disabled (then it is recomputed).
+
+        Examples
+        --------
+        >>> Cache(Path("/tmp/c"), enabled=False).get("fea", "abcd") is None
+        True
+        """
         if not self.enabled:
             return None
         try:
@@ -76,6 +153,42 @@ class Cache:
             return None
 
     def put(self, stage: str, key: str, value: Any) -> None:
+        """Store a stage's output atomically (nothing when the cache is disabled).
+
+        Parameters
+        ----------
+        stage : str
+            The stage's name.
+        key : str
+            Its key (`digest`).
+        value : Any
+            The output; it must pickle.
+
+        Examples
+        --------
+        >>> Cache(Path("/tmp/c")).put("fea", "abcd", {"k_Nm_per_rad": 9.1})
+        """
         if not self.enabled:
             return
         atomic_write(self.path(stage, key), lambda tmp: tmp.write_bytes(pickle.dumps(value, pickle.HIGHEST_PROTOCOL)))
+
+
+def default_cache(cache_dir: str | Path | None = None) -> Cache:
+    """The stage cache the commands use.
+
+    Parameters
+    ----------
+    cache_dir : str or Path, optional
+        Its folder; None: $SEADESIGN_CACHE as set now, else ~/.cache/seadesign.
+
+    Returns
+    -------
+    Cache
+        An enabled cache rooted there.
+
+    Examples
+    --------
+    >>> default_cache("/tmp/seadesign-cache").root
+    PosixPath('/tmp/seadesign-cache')
+    """
+    return Cache(Path(cache_dir) if cache_dir else _default_cache_dir())
