@@ -5,7 +5,7 @@ the global ones. Shape-function gradients are G_a = sum_j D[q, a, j] Gamma_j (1/
 derivatives D of the reference element and each element's barycentric gradients Gamma.
 
 Each loop makes one pass per element and quadrature point, where NumPy needs several passes over
-(m, q, nen, 3) temporaries (the README gives the measured times). Compiled by numba (cadquery installs it),
+(m, q, nen, 3) temporaries (docs/validation/timing.md gives the measured times). Compiled by numba (cadquery installs it),
 cached on disk after the first call.
 """
 
