@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers_annulus import annulus_mesh
+from helpers_neo_hooke import neo_hooke_cauchy, uniaxial
 from helpers_skfem import neo_hooke_forms, skfem_permutation
 from skfem import asm
 
@@ -118,22 +119,6 @@ def test_tangent_at_rest_is_the_linear_stiffness(small):
             assert 1e-3 < err
 
 
-def _neo_hooke_cauchy(F: np.ndarray) -> np.ndarray:
-    """The compressible neo-Hookean Cauchy stress in closed form: 2 C10 J^(-5/3) dev(F F^T) + 2 (J - 1) / D1 I."""
-    J, b = np.linalg.det(F), F @ F.T
-    return 2 * NEO.c10_Pa * J ** (-5 / 3) * (b - np.trace(b) / 3 * np.eye(3)) + 2 * (J - 1) / NEO.d1_per_Pa * np.eye(3)
-
-
-def _uniaxial(stretch: float) -> np.ndarray:
-    """F = diag(stretch, s, s) with the lateral Cauchy stress zero (free faces), s found by bisection."""
-    lo, hi = 0.3, 3.0
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        lateral = _neo_hooke_cauchy(np.diag([stretch, mid, mid]))[1, 1]
-        lo, hi = (mid, hi) if lateral < 0 else (lo, mid)
-    return np.diag([stretch, 0.5 * (lo + hi), 0.5 * (lo + hi)])
-
-
 GENERAL_F = np.array([[1.3, 0.4, 0.0], [0.1, 0.9, 0.05], [0.0, -0.2, 1.1]])  # J = 1.25: every principal stress tensile
 
 
@@ -147,7 +132,7 @@ def test_element_strain_and_cauchy_von_mises_of_a_homogeneous_deformation(small,
     emesh = element_mesh(points, tets, 2)
     u = emesh.nodes_m @ (F - np.eye(3)).T
     result = Solid.of(emesh, NEO, formulation).element_strain_stress(u)
-    sigma = _neo_hooke_cauchy(F)
+    sigma = neo_hooke_cauchy(NEO, F)
     lam2, n = np.linalg.eigh(F @ F.T)
     principal = np.array([n[:, i] @ sigma @ n[:, i] for i in range(3)])
     stretch = np.sqrt(lam2)
@@ -167,7 +152,7 @@ def test_a_block_in_uniaxial_compression_has_no_tensile_strain_and_in_tension_it
     criterion is axial - 1 and the lateral contraction carries no stress, so no compression counts."""
     points, tets = small
     emesh = element_mesh(points, tets, 2)
-    F = _uniaxial(axial)
+    F = uniaxial(NEO, axial)
     assert F[1, 1] > 1.0 if axial < 1 else F[1, 1] < 1.0  # the bulge (or the contraction) is there
     result = Solid.of(emesh, NEO, "full").element_strain_stress(emesh.nodes_m @ (F - np.eye(3)).T)
     tensile, compressive = (0.0, 1 - axial) if axial < 1 else (axial - 1, 0.0)

@@ -66,6 +66,11 @@ class Hyperelastic:
         return cls("neo_hooke", c10_Pa=mu / 2.0, d1_per_Pa=2.0 / bulk,
                    source="derived from E and nu: C10 = mu / 2, D1 = 2 / K (small-strain limit = the linear model)")
 
+    @property
+    def shear_modulus_Pa(self) -> float:
+        """The initial shear modulus mu = 2 (C10 + C01) (Pa)."""
+        return 2.0 * (self.c10_Pa + self.c01_Pa)
+
 
 @dataclass(frozen=True)
 class StrainLimits:

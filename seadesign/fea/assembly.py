@@ -46,6 +46,21 @@ class UpperBlocks:
         return sp.bsr_matrix((self.values, self.cols, indptr), shape=(d * self.n, d * self.n))
 
 
+def add_pair_blocks(upper: UpperBlocks, node_index: np.ndarray, nodes: np.ndarray, blocks: np.ndarray) -> UpperBlocks:
+    """`upper` plus the blocks (P, q, q, d, d) of the dense q x q node groups `nodes` (P, q) (a contact pair's
+    coupling), mapped by node_index to block rows (-1: dropped); new entries join the sparsity pattern."""
+    r = node_index[nodes][:, :, None].repeat(nodes.shape[1], axis=2)
+    c = np.swapaxes(r, 1, 2)
+    keep = (r >= 0) & (c >= 0) & (r <= c)
+    d = blocks.shape[-1]
+    rows = np.concatenate([upper.rows, r[keep]])
+    cols = np.concatenate([upper.cols, c[keep]])
+    keys, inv = np.unique(rows.astype(np.int64) * upper.n + cols, return_inverse=True)
+    values = np.zeros((len(keys), d, d))
+    np.add.at(values, inv, np.concatenate([upper.values, blocks[keep]]))
+    return UpperBlocks(keys // upper.n, keys % upper.n, values, upper.n)
+
+
 @dataclass(frozen=True)
 class PairPattern:
     """Where the element pair blocks (P, m, d, d) of one mesh and numbering land in the global upper

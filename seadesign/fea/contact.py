@@ -8,11 +8,13 @@ gap is their separation along the normals, negative once they overlap. Positions
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial import cKDTree
 
+from seadesign.errors import ConfigError, SolverError
+from seadesign.fea.elements import ElementMesh, midside_nodes
 from seadesign.fea.torsion import MM
 
 
@@ -63,3 +65,351 @@ def _gap(x: np.ndarray, n: np.ndarray, pairs: np.ndarray) -> np.ndarray:
     """Separation of vertex pairs along their normals (m); positive across open space, negative through material."""
     d = x[pairs[:, 1]] - x[pairs[:, 0]]
     return 0.5 * np.einsum("ij,ij->i", d, n[pairs[:, 0]] - n[pairs[:, 1]])
+
+
+# --- frictionless contact: Gauss points of the quadratic boundary faces against flat facets -------------------------
+
+# The quadratic boundary face (corners 0-2, then the midsides of edges 01, 12, 20) split into four flat facets
+SUBFACETS = np.array([[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]])
+# Dunavant's 6-point rule on the triangle (degree 4): barycentric points and weights summing to 1
+_A, _B = 0.445948490915965, 0.091576213509771
+FACE_POINTS = np.array([[_A, _A, 1 - 2 * _A], [_A, 1 - 2 * _A, _A], [1 - 2 * _A, _A, _A],
+                        [_B, _B, 1 - 2 * _B], [_B, 1 - 2 * _B, _B], [1 - 2 * _B, _B, _B]])
+FACE_WEIGHTS = np.array([0.223381589678011] * 3 + [0.109951743655322] * 3)
+
+
+def face_shape_values(lam: np.ndarray) -> np.ndarray:
+    """Quadratic triangle shape functions (q, 6) at barycentric points lam (q, 3): corners, then midsides 01, 12, 20."""
+    l0, l1, l2 = lam.T
+    return np.column_stack([l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1), 4 * l0 * l1, 4 * l1 * l2, 4 * l2 * l0])
+
+
+def _cross_matrix(v: np.ndarray) -> np.ndarray:
+    """[v]x (..., 3, 3): [v]x w = v x w."""
+    z = np.zeros(v.shape[:-1])
+    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1),
+                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
+
+
+def plane_gap(d: np.ndarray, e1: np.ndarray, e2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The signed distance g = d . n of points from the planes of facets (P,), n = e1 x e2 / |e1 x e2|, with d the
+    point minus the facet's first corner and e1, e2 its edges from there (P, 3, m); and its gradient (P, 3, 3) and
+    Hessian (P, 3, 3, 3, 3) in the variables (d, e1, e2): [variable, component] and
+    [variable, variable, component, component]."""
+    m = np.cross(e1, e2)
+    a = np.linalg.norm(m, axis=1)
+    n = m / a[:, None]
+    g = np.einsum("pi,pi->p", d, n)
+    p = (d - g[:, None] * n) / a[:, None]  # dg/dm
+    grad = np.stack([n, np.cross(e2, p), np.cross(p, e1)], axis=1)
+    proj = np.eye(3) - n[:, :, None] * n[:, None, :]
+    h_mm = -(n[:, :, None] * p[:, None, :] + p[:, :, None] * n[:, None, :]) / a[:, None, None] \
+        - g[:, None, None] * proj / (a**2)[:, None, None]
+    j1, j2 = -_cross_matrix(e2), _cross_matrix(e1)  # dm/de1, dm/de2
+    h_dm = proj / a[:, None, None]
+    hess = np.zeros((len(g), 3, 3, 3, 3))
+    hess[:, 0, 1], hess[:, 0, 2] = h_dm @ j1, h_dm @ j2
+    hess[:, 1, 0], hess[:, 2, 0] = np.swapaxes(hess[:, 0, 1], 1, 2), np.swapaxes(hess[:, 0, 2], 1, 2)
+    hess[:, 1, 1] = np.swapaxes(j1, 1, 2) @ h_mm @ j1
+    hess[:, 2, 2] = np.swapaxes(j2, 1, 2) @ h_mm @ j2
+    hess[:, 1, 2] = np.swapaxes(j1, 1, 2) @ h_mm @ j2 - _cross_matrix(p)
+    hess[:, 2, 1] = np.swapaxes(hess[:, 1, 2], 1, 2)
+    return g, grad, hess
+
+
+@dataclass(frozen=True)
+class ContactSettings:
+    """Frictionless contact by an augmented Lagrangian: penalty stiffness `penalty_factor` times the law's
+    shear modulus over the mean boundary edge length (Pa/m), multipliers updated until the largest
+    penetration is below `penetration_tol_mm`, at most `max_augmentations` times an increment.
+
+    `geometric_tangent`: the tangent also carries the pressure's geometric part, - w t hess g, the exact second
+    derivative of the contact energy. On flat facets that part grows as the pressure over the facet's size (a
+    facet's rotation turns its force), a discretisation artefact that makes the tangent indefinite at creases,
+    where the path would read it as buckling; so by default the tangent keeps the normal stiffness w eps grad g
+    grad g only, and the quasi-Newton updates supply the rest."""
+
+    penalty_factor: float = 10.0
+    penetration_tol_mm: float = 0.0045  # 1 % of the default study's 0.45 mm fillet radius
+    max_augmentations: int = 30
+    search_mm: float = 0.1  # beyond a facet's reach (its largest centroid-to-corner distance), how far from its
+    # centroid a point is paired with it: more than any gap that can carry pressure
+    geometric_tangent: bool = False
+
+    def __post_init__(self) -> None:
+        for key in ("penalty_factor", "penetration_tol_mm", "search_mm"):
+            if not getattr(self, key) > 0:
+                raise ConfigError(f"contact setting {key} must be positive, got {getattr(self, key)!r}")
+        if self.max_augmentations < 1:
+            raise ConfigError(f"contact setting max_augmentations must be at least 1, got {self.max_augmentations!r}")
+
+
+@dataclass(frozen=True)
+class ContactSurface:
+    """The boundary of a quadratic tetrahedral mesh for contact: its 6-node faces (corners, then the midsides
+    of edges 01, 12, 20), their flat facets (four a face), the faces' Gauss points and weights (rest area, m^2).
+
+    One pass: where two faces i and j meet, the Gauss points of one are checked against the facets of the
+    other, never both ways (two passes over-constrain the contact and share its load arbitrarily). The
+    points of a face whose nodes are all prescribed (a held or driven surface) are never checked; between
+    two faces with free nodes, those of the lower-numbered face are."""
+
+    nodes_m: np.ndarray
+    faces: np.ndarray  # (k, 6)
+    facets: np.ndarray  # (4k, 3) node ids, outward
+    weights_m2: np.ndarray  # (6k,) Gauss point weights, face-major
+    shape: np.ndarray  # (6, 6) shape functions at the Gauss points [point, node]
+    rest_points_m: np.ndarray  # (6k, 3)
+    checked: np.ndarray  # (k,) bool: the face has a free node, so its points are checked
+    checked_points: np.ndarray  # the Gauss points of the checked faces
+
+    @classmethod
+    def of(cls, emesh: ElementMesh, boundary_faces: np.ndarray, prescribed: np.ndarray) -> "ContactSurface":
+        """The surface of `emesh` on its linear boundary facets (k, 3); `prescribed`: node ids held or driven."""
+        if emesh.order != 2:
+            raise SolverError("contact needs quadratic (order 2) elements")
+        c = boundary_faces
+        mids = [midside_nodes(emesh, c[:, i], c[:, j]) for i, j in ((0, 1), (1, 2), (2, 0))]
+        faces = np.column_stack([c, *mids])
+        facets = faces[:, SUBFACETS].reshape(-1, 3)
+        x = emesh.nodes_m
+        area = 0.5 * np.linalg.norm(np.cross(x[c[:, 1]] - x[c[:, 0]], x[c[:, 2]] - x[c[:, 0]]), axis=1)
+        shape = face_shape_values(FACE_POINTS)
+        checked = ~np.isin(faces, prescribed).all(axis=1)
+        return cls(x, faces, facets, (area[:, None] * FACE_WEIGHTS).ravel(), shape, _points(shape, x, faces), checked,
+                   np.flatnonzero(np.repeat(checked, len(FACE_WEIGHTS))))
+
+    def points(self, u: np.ndarray) -> np.ndarray:
+        """(6k, 3) Gauss points (m) of the surface deformed by u."""
+        return _points(self.shape, self.nodes_m + u, self.faces)
+
+
+def _points(shape: np.ndarray, x: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    return np.einsum("qa,kai->kqi", shape, x[faces]).reshape(-1, 3)
+
+
+@dataclass(frozen=True)
+class ContactPairs:
+    """Each Gauss point paired with the facet it faces (the nearest plane it projects inside), its gap (m,
+    negative: penetration) and the pair's nine nodes (the point's face's six, the facet's three)."""
+
+    point: np.ndarray
+    facet: np.ndarray
+    gap_m: np.ndarray
+    nodes: np.ndarray  # (P, 9)
+    coefficients: np.ndarray  # (P, 3, 9): (d, e1, e2) = coefficients @ node positions
+
+
+@dataclass(frozen=True)
+class ContactSummary:
+    """Contact at one state: the rest area under pressure (m^2), the largest pressure (Pa, per rest area) and where
+    (its point at rest, mm), the sum of the absolute moments about z of the pair forces (Nm: the torque that
+    crosses contact) and the largest penetration (m)."""
+
+    area_m2: float
+    peak_pressure_Pa: float
+    peak_at_mm: tuple[float, float, float]
+    moment_Nm: float
+    penetration_m: float
+
+
+@dataclass
+class FrictionlessContact:
+    """Frictionless self-contact of a part's boundary as an energy: each Gauss point of a face that faces a
+    flat facet across open space (normals more than 90 degrees apart now, the point in front of the
+    facet's plane at rest, the facet not on the point's face) stores w / (2 eps) (max(0, lam - eps g)^2 - lam^2)
+    with g its distance from the facet's plane, w its rest weight, eps the penalty (Pa/m) and lam its
+    multiplier (Pa): the contact pressure is max(0, lam - eps g). Exact forces and tangent of that energy."""
+
+    surface: ContactSurface
+    settings: ContactSettings
+    penalty_Pa_per_m: float
+    multipliers_Pa: np.ndarray = field(repr=False)
+    assignment: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)  # (points, facets): `search`
+
+    @classmethod
+    def of(cls, surface: ContactSurface, shear_modulus_Pa: float, settings: ContactSettings) -> "FrictionlessContact":
+        edges = surface.nodes_m[surface.facets] - np.roll(surface.nodes_m[surface.facets], 1, axis=1)
+        h = float(np.linalg.norm(edges, axis=2).mean())
+        return cls(surface, settings, settings.penalty_factor * shear_modulus_Pa / h,
+                   np.zeros(len(surface.weights_m2)))
+
+    def search(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The Gauss points paired with facets at u (m): (points, facets). Assigned (`assignment`), the pairs hold
+        until the next assignment, so that the contact energy is smooth in between: a point's gap is its distance
+        from its facet's plane, extended past the facet's edges. Candidates: a point within a facet's reach (its largest centroid-to-corner distance plus
+        `search_mm`) of its centroid, the point in front of the facet's plane at rest, the point checked against
+        the facet (see `ContactSurface`), the facet not touching the point's face; of these, a point is paired with
+        the nearest plane among the facets it projects inside whose normal is more than 90 degrees from its face's."""
+        s = self.surface
+        x = s.nodes_m + u
+        xq = s.points(u)
+        tri = x[s.facets]
+        centroids = tri.mean(axis=1)
+        reach = self.settings.search_mm * MM + np.linalg.norm(tri - centroids[:, None], axis=2).max(axis=1)
+        n_facet = _unit(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]))
+        corners = x[s.faces[:, :3]]
+        n_face = _unit(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
+        q, f = _facing_candidates(xq, n_face, s.checked_points, centroids, n_facet, reach)
+        face, other = q // len(FACE_WEIGHTS), f // len(SUBFACETS)
+        keep = s.checked[face] & (~s.checked[other] | (face < other))
+        keep &= ~(s.faces[face][:, :, None] == s.facets[f][:, None, :]).any(axis=(1, 2))
+        q, f = q[keep], f[keep]
+        x0 = s.nodes_m[s.facets[f]]
+        n0 = np.cross(x0[:, 1] - x0[:, 0], x0[:, 2] - x0[:, 0])
+        ahead = np.einsum("pi,pi->p", s.rest_points_m[q] - x0[:, 0], n0) > 0
+        q, f = q[ahead], f[ahead]
+        gap, n, inside = self._planes(u, q, f)
+        own = x[s.faces[q // len(FACE_WEIGHTS), :3]]
+        opposed = np.einsum("pi,pi->p", n, np.cross(own[:, 1] - own[:, 0], own[:, 2] - own[:, 0])) < 0
+        q, f, gap = q[opposed & inside], f[opposed & inside], gap[opposed & inside]
+        order = np.lexsort((np.abs(gap), q))  # per point, the nearest plane first
+        first = order[np.r_[True, q[order][1:] != q[order][:-1]]] if len(order) else order
+        return q[first], f[first]
+
+    def new_pairs(self, assignment: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """The pairs of `assignment` that the current assignment does not hold."""
+        key = assignment[0] * len(self.surface.facets) + assignment[1]
+        held = np.isin(key, self.assignment[0] * len(self.surface.facets) + self.assignment[1])
+        return assignment[0][~held], assignment[1][~held]
+
+    def _planes(self, u: np.ndarray, q: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Distance (m) of points q from the planes of facets f at u, the facets' unit normals, and whether the
+        points project inside the facets."""
+        s = self.surface
+        tri = (s.nodes_m + u)[s.facets[f]]
+        e1, e2, d = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], s.points(u)[q] - tri[:, 0]
+        n = _unit(np.cross(e1, e2))
+        gap = np.einsum("pi,pi->p", d, n)
+        return gap, n, _inside(d - gap[:, None] * n, e1, e2)
+
+    def pairs(self, u: np.ndarray, assignment: tuple[np.ndarray, np.ndarray] | None = None) -> ContactPairs:
+        """The assigned pairs (or those given; searched at u if none is assigned) with their gaps at u (m)."""
+        s = self.surface
+        if assignment is None and self.assignment is None:
+            self.assignment = self.search(u)
+        q, f = assignment or self.assignment
+        face = q // len(FACE_WEIGHTS)
+        gap = self._planes(u, q, f)[0]
+        coef = np.zeros((len(q), 3, 9))
+        coef[:, 0, :6] = s.shape[q % len(FACE_WEIGHTS)]
+        coef[:, :, 6] = -1.0
+        coef[:, 1, 7] = coef[:, 2, 8] = 1.0
+        return ContactPairs(q, f, gap, np.column_stack([s.faces[face], s.facets[f]]), coef)
+
+    def active(self, u: np.ndarray) -> np.ndarray:
+        """The (point, facet) pairs under pressure at u, (P, 2) sorted."""
+        pairs = self.pairs(u)
+        pressed = self.pressure_Pa(pairs) > 0
+        return np.column_stack([pairs.point[pressed], pairs.facet[pressed]])
+
+    def pressure_Pa(self, pairs: ContactPairs) -> np.ndarray:
+        """max(0, lam - eps g) at the paired points (Pa)."""
+        return np.maximum(0.0, self.multipliers_Pa[pairs.point] - self.penalty_Pa_per_m * pairs.gap_m)
+
+    def energy(self, u: np.ndarray) -> float:
+        """The contact energy (J) at u."""
+        pairs, eps, w = self.pairs(u), self.penalty_Pa_per_m, self.surface.weights_m2
+        t = self.pressure_Pa(pairs)
+        return float(np.sum(w[pairs.point] * t**2) - np.sum(w * self.multipliers_Pa**2)) / (2 * eps)
+
+    def forces(self, u: np.ndarray) -> np.ndarray:
+        """(N, 3) nodal forces dW/du (N)."""
+        f = np.zeros_like(u)
+        pairs = self.pairs(u)
+        t = self.pressure_Pa(pairs)
+        active = t > 0
+        if active.any():
+            grad = self._gradient(u, pairs, active)
+            np.add.at(f, pairs.nodes[active], -(self.surface.weights_m2[pairs.point[active]] * t[active])[:, None, None] * grad)
+        return f
+
+    def tangent_blocks(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The active pairs' nodes (P, 9) and their 9 x 9 tangent blocks (P, 9, 9, 3, 3) in N/m: w eps grad g grad g,
+        with `geometric_tangent` also - w t hess g."""
+        pairs = self.pairs(u)
+        t = self.pressure_Pa(pairs)
+        a = t > 0
+        if not a.any():
+            return np.empty((0, 9), dtype=np.int64), np.empty((0, 9, 9, 3, 3))
+        y, c = self._variables(u, pairs, a)
+        _, grad_y, hess_y = plane_gap(*y)
+        grad = np.einsum("pia,pic->pac", c, grad_y)
+        w = self.surface.weights_m2[pairs.point[a]]
+        blocks = (w * self.penalty_Pa_per_m)[:, None, None, None, None] * grad[:, :, None, :, None] * grad[:, None, :, None, :]
+        if self.settings.geometric_tangent:
+            blocks -= (w * t[a])[:, None, None, None, None] * np.einsum("pia,pjb,pijkl->pabkl", c, c, hess_y)
+        return pairs.nodes[a], blocks
+
+    def summary(self, u: np.ndarray) -> ContactSummary:
+        """The contact at u: area under pressure, its peak and where, the pairs' moment about z, the penetration."""
+        pairs = self.pairs(u)
+        t = self.pressure_Pa(pairs)
+        a = t > 0
+        if not a.any():
+            return ContactSummary(0.0, 0.0, (float("nan"),) * 3, 0.0, 0.0)
+        w = self.surface.weights_m2[pairs.point[a]]
+        x = self.surface.points(u)[pairs.point[a]]
+        force = -(w * t[a])[:, None] * self._gradient(u, pairs, a)[:, :6].sum(axis=1)  # on the checked points' faces
+        moment = np.abs(x[:, 0] * force[:, 1] - x[:, 1] * force[:, 0]).sum()
+        k = int(np.argmax(t[a]))
+        at = tuple(float(c) for c in self.surface.rest_points_m[pairs.point[a][k]] / MM)
+        return ContactSummary(float(w.sum()), float(t[a][k]), at, float(moment), float(max(0.0, -pairs.gap_m[a].min())))
+
+    def augment(self, u: np.ndarray) -> None:
+        """Multipliers <- the pressures at u (Uzawa's update); points without a facet carry none."""
+        pairs = self.pairs(u)
+        lam = np.zeros_like(self.multipliers_Pa)
+        lam[pairs.point] = self.pressure_Pa(pairs)
+        self.multipliers_Pa = lam
+
+    def penetration_m(self, u: np.ndarray, assignment: tuple[np.ndarray, np.ndarray] | None = None) -> float:
+        """The largest penetration (m) of a point under pressure at u, 0 without one (pairs as in `pairs`)."""
+        pairs = self.pairs(u, assignment)
+        pressed = self.pressure_Pa(pairs) > 0
+        return float(max(0.0, -pairs.gap_m[pressed].min())) if pressed.any() else 0.0
+
+    def _variables(self, u: np.ndarray, pairs: ContactPairs, which: np.ndarray) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
+        c = pairs.coefficients[which]
+        y = np.einsum("pva,pai->vpi", c, (self.surface.nodes_m + u)[pairs.nodes[which]])
+        return (y[0], y[1], y[2]), c
+
+    def _gradient(self, u: np.ndarray, pairs: ContactPairs, which: np.ndarray) -> np.ndarray:
+        y, c = self._variables(u, pairs, which)
+        return np.einsum("pia,pic->pac", c, plane_gap(*y)[1])
+
+
+def _facing_candidates(xq: np.ndarray, n_face: np.ndarray, points: np.ndarray, centroids: np.ndarray,
+                       n_facet: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(point, facet) pairs, among `points`, within each facet's reach of its centroid with the point's face normal
+    opposed to the facet's (cosine below 0), and some more. The search is in (position, a x normal): there an
+    opposed pair within the reach r lies within sqrt(r^2 + 2 a^2), two points of one smooth surface (normals alike)
+    2 a apart, further for a >= r. Facets are searched in classes of reach doubling from the smallest, a = the
+    class's largest reach, so that a large facet does not pull in its surface's neighbours."""
+    classes = np.floor(np.log2(reach / reach.min())).astype(np.int64)
+    found_q, found_f = [], []
+    for c in np.unique(classes):
+        facets = np.flatnonzero(classes == c)
+        a = float(reach[facets].max())
+        tree = cKDTree(np.hstack([xq[points], -a * n_face[points // len(FACE_WEIGHTS)]]))
+        near = tree.query_ball_point(np.hstack([centroids[facets], a * n_facet[facets]]), np.sqrt(reach[facets]**2 + 2 * a**2))
+        counts = np.fromiter(map(len, near), dtype=np.int64, count=len(near))
+        if counts.sum():
+            found_q.append(points[np.concatenate(near).astype(np.int64)])
+            found_f.append(np.repeat(facets, counts))
+    if not found_q:
+        return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    return np.concatenate(found_q), np.concatenate(found_f)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=1)[:, None]
+
+
+def _inside(r: np.ndarray, e1: np.ndarray, e2: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """Whether in-plane offsets r (from a facet's first corner) lie in the facets spanned by e1, e2."""
+    a11, a12, a22 = (np.einsum("pi,pi->p", a, b) for a, b in ((e1, e1), (e1, e2), (e2, e2)))
+    b1, b2 = np.einsum("pi,pi->p", r, e1), np.einsum("pi,pi->p", r, e2)
+    det = a11 * a22 - a12**2
+    s, t = (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
+    return (s >= -tol) & (t >= -tol) & (s + t <= 1 + tol)

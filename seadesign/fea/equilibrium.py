@@ -9,15 +9,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from seadesign.errors import NotPositiveDefinite
-from seadesign.fea.assembly import PairPattern
+from seadesign.fea.assembly import PairPattern, add_pair_blocks
+from seadesign.fea.contact import FrictionlessContact
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.pardiso import Pardiso
 
 
 @dataclass
 class Equilibrium:
-    """A solid whose nodes outside `free` are prescribed; `reaction` are the nodes whose forces set the
-    convergence scale (the driven ones)."""
+    """A solid, and its frictionless self-contact if any, whose nodes outside `free` are prescribed; `reaction`
+    are the nodes whose forces set the convergence scale (the driven ones)."""
 
     solid: Solid
     free: np.ndarray
@@ -26,12 +27,13 @@ class Equilibrium:
     reaction: np.ndarray
     force_rtol: float  # residual norm over the norm of the reaction forces
     pattern: PairPattern  # where the tangent's element blocks land (free nodes only)
+    contact: FrictionlessContact | None = None
     pardiso: Pardiso | None = None  # the factorization last made
     factorizations: int = 0
 
     @classmethod
     def of(cls, solid: Solid, prescribed: np.ndarray, reaction: np.ndarray, force_rtol: float,
-           held_z: np.ndarray | None = None) -> "Equilibrium":
+           held_z: np.ndarray | None = None, contact: FrictionlessContact | None = None) -> "Equilibrium":
         """Free nodes: all but `prescribed`; `held_z`: nodes whose u_z stays zero (an analytical test's plane)."""
         n = len(solid.mesh.nodes_m)
         free = np.setdiff1d(np.arange(n), prescribed)
@@ -42,15 +44,25 @@ class Equilibrium:
             held = index[held_z]
             dof_free[held[held >= 0], 2] = 0.0
         return cls(solid, free, index, dof_free, reaction, force_rtol,
-                   PairPattern.of(solid.mesh.elements, solid.mesh.order, index, len(free)))
+                   PairPattern.of(solid.mesh.elements, solid.mesh.order, index, len(free)), contact)
 
     def forces(self, u: np.ndarray) -> np.ndarray:
-        """(N, 3) internal forces (N) at u."""
-        return self.solid.forces(u)
+        """(N, 3) internal forces (N) at u: the solid's and the contact's."""
+        f = self.solid.forces(u)
+        return f if self.contact is None else f + self.contact.forces(u)
 
     def energy(self, u: np.ndarray) -> float:
-        """Stored energy (J) at u."""
-        return self.solid.energy(u)
+        """Stored energy (J) at u: the strain energy and the contact's."""
+        e = self.solid.energy(u)
+        return e if self.contact is None else e + self.contact.energy(u)
+
+    def tangent_product(self, u: np.ndarray, v: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
+        """(N, 3) tangent at u times the nodal vector v (N); `rows`: see `Solid.tangent_product`."""
+        f = self.solid.tangent_product(u, v, rows)
+        if self.contact is not None:
+            nodes, blocks = self.contact.tangent_blocks(u)
+            np.add.at(f, nodes, np.einsum("pabij,pbj->pai", blocks, v[nodes]))
+        return f
 
     def residual(self, f: np.ndarray) -> np.ndarray:
         """The out-of-balance forces (N) on the free degrees of freedom, flattened."""
@@ -65,11 +77,16 @@ class Equilibrium:
         negative eigenvalue (the state has lost stability). The inertia is exact, where a Cholesky
         factorization near a singular point may or may not meet its negative pivot."""
         k = self.solid.tangent(u, self.pattern)
+        if self.contact is not None:
+            nodes, blocks = self.contact.tangent_blocks(u)
+            if len(nodes):
+                k = add_pair_blocks(k, self.node_index, nodes, blocks)
         self._hold(k)
         k = k.matrix()
-        if self.pardiso is not None and self.pardiso.alive:
+        if self.pardiso is not None and self.pardiso.alive and self.pardiso.same_pattern(k):
             self.pardiso.refactor(k)
         else:
+            self.close()
             self.pardiso = Pardiso(k, indefinite=True)
         self.factorizations += 1
         if self.pardiso.inertia()[1] > 0:

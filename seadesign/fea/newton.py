@@ -21,12 +21,48 @@ class NewtonSettings:
 class NewtonResult:
     """The last iterate u (m), its internal forces (N; None when they could not be evaluated), the residual
     norms (N) of the iterations and the status: "converged", "unstable" (a tangent that is not positive
-    definite) or "failed"."""
+    definite), "failed", or "penetrating" (equilibrium, but contact the multiplier updates could not bring
+    within its penetration tolerance; `penetration_m` says how far)."""
 
     u: np.ndarray
     forces: np.ndarray | None
     residual_norms: list[float]
     status: str
+    penetration_m: float = 0.0
+    augmentations: int = 0
+
+
+def newton_augmented(system: Equilibrium, u0: np.ndarray, settings: NewtonSettings = NewtonSettings()) -> NewtonResult:
+    """`newton` with the contact pairs searched at u0 and held (the contact search once an increment); then, while
+    the solution penetrates further than the contact's tolerance, Uzawa's update of the contact multipliers and
+    `newton` again: the augmented Lagrangian. Penetration is also measured on the pairs searched afresh at the
+    solution; where those penetrate beyond the tolerance (a point the held pairs missed), they are assigned first.
+    The residual norms of all the solves; status "penetrating" when `max_augmentations` rounds did not bring the
+    penetration within the tolerance."""
+    contact = system.contact
+    if contact is not None:
+        contact.assignment = contact.search(u0)
+    result = newton(system, u0, settings)
+    if contact is None or result.status != "converged":
+        return result
+    norms, tol = list(result.residual_norms), contact.settings.penetration_tol_mm * 1e-3
+    for k in range(contact.settings.max_augmentations + 1):
+        fresh = contact.search(result.u)
+        missed = contact.penetration_m(result.u, contact.new_pairs(fresh)) > tol
+        if missed:
+            contact.assignment = fresh
+        depth = contact.penetration_m(result.u)
+        if depth <= tol:
+            return NewtonResult(result.u, result.forces, norms, "converged", depth, k)
+        if k == contact.settings.max_augmentations:
+            break
+        if not missed:
+            contact.augment(result.u)
+        result = newton(system, result.u, settings)
+        norms += result.residual_norms
+        if result.status != "converged":
+            return NewtonResult(result.u, result.forces, norms, result.status, depth, k + 1)
+    return NewtonResult(result.u, result.forces, norms, "penetrating", depth, contact.settings.max_augmentations)
 
 
 def newton(system: Equilibrium, u0: np.ndarray, settings: NewtonSettings = NewtonSettings()) -> NewtonResult:

@@ -8,8 +8,7 @@ digits, took another route on every run. Results may still depend on the number 
 reproducibility for a fixed number).
 
 Block storage matters: PARDISO then orders the node graph, nine times smaller than the
-scalar one (on a 374k-dof spring: analysis 1.0 s instead of 4.1 s, factorization 4.0 s
-instead of 5.7 s).
+scalar one (measured in docs/validation/linear-fea.md).
 """
 
 from __future__ import annotations
@@ -84,7 +83,7 @@ class Pardiso:
         # direct solution's residual is 1e-13 relative here, and each refinement step costs a solve
         if indefinite:
             self._iparm[20] = 0  # 1x1 diagonal pivots, not Bunch-Kaufman's 2x2: the path's tangents are positive
-            # definite or lose it by a few eigenvalues, and the factorization is 27 % faster (8 x 4 mm path mesh)
+            # definite or lose it by a few eigenvalues, and the factorization is faster (docs/validation/timing.md)
         self._iparm[34] = 1  # zero-based indices
         self._iparm[36] = block if block > 1 else 0
         self._alive = True
@@ -134,10 +133,14 @@ class Pardiso:
             raise SolverError("inertia needs Pardiso(..., indefinite=True)")
         return int(self._iparm[21]), int(self._iparm[22]), int(self._iparm[13])
 
+    def same_pattern(self, upper: sp.csr_matrix | sp.bsr_matrix) -> bool:
+        """Whether `upper` has the sparsity pattern of the first factorization (sorts its indices)."""
+        upper.sort_indices()
+        return np.array_equal(upper.indptr, self._ia) and np.array_equal(upper.indices, self._ja)
+
     def refactor(self, upper: sp.csr_matrix | sp.bsr_matrix) -> None:
         """Factor new values on the same sparsity pattern, reusing the ordering and symbolic analysis."""
-        upper.sort_indices()
-        if not (np.array_equal(upper.indptr, self._ia) and np.array_equal(upper.indices, self._ja)):
+        if not self.same_pattern(upper):
             raise SolverError("refactor needs the sparsity pattern of the first factorization")
         self._data = np.ascontiguousarray(upper.data, dtype=np.float64)
         self._call(22, np.zeros(self.n))
@@ -154,4 +157,7 @@ class Pardiso:
             self._call(-1, np.zeros(self.n))
 
     def __del__(self) -> None:
-        self.close()
+        try:
+            self.close()
+        except ImportError:  # the interpreter is shutting down and ctypes cannot call any more
+            pass

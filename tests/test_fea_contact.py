@@ -1,0 +1,144 @@
+"""Frictionless contact against independent references: PyTorch's automatic derivatives of the gap, finite
+differences of the contact energy, and the contact patch test (a block pressed onto a flat face takes the closed-
+form homogeneous uniaxial state of the neo-Hookean law, helpers_neo_hooke) on conforming and non-conforming meshes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers_contact import two_blocks
+from helpers_neo_hooke import neo_hooke_cauchy, uniaxial
+
+from seadesign.design.materials import Hyperelastic
+from seadesign.errors import ConfigError
+from seadesign.fea.contact import ContactSettings, ContactSurface, FrictionlessContact, plane_gap
+from seadesign.fea.elements import element_mesh, midside_nodes
+from seadesign.fea.equilibrium import Equilibrium
+from seadesign.fea.finite_strain import Solid
+from seadesign.fea.newton import newton_augmented
+from seadesign.fea.torsion import MM
+
+LAW = Hyperelastic.from_linear(10e6, 0.45)
+GAP_MM, SQUEEZE_MM = 0.01, 0.05  # the top block starts 0.01 mm above the base; its top face is pushed 0.06 mm down
+
+
+def test_plane_gap_gradient_and_hessian_equal_automatic_differentiation():
+    torch = pytest.importorskip("torch")
+    rng = np.random.default_rng(0)
+    d, e1, e2 = (rng.normal(size=(5, 3)) for _ in range(3))
+    g, grad, hess = plane_gap(d, e1, e2)
+
+    def gap(y):
+        m = torch.linalg.cross(y[1], y[2])
+        return y[0] @ (m / torch.linalg.norm(m))
+
+    for k in range(5):
+        y = torch.tensor(np.stack([d[k], e1[k], e2[k]]), dtype=torch.float64)
+        assert gap(y).item() == pytest.approx(g[k], abs=1e-14)
+        assert np.abs(torch.autograd.functional.jacobian(gap, y).numpy() - grad[k]).max() < 1e-14  # measured 4e-16
+        h = torch.autograd.functional.hessian(gap, y).numpy().transpose(0, 2, 1, 3)
+        assert np.abs(h - hess[k]).max() < 1e-13  # measured 2e-15
+
+
+def _blocks(base_cells: int, top_cells: int, rigid_base: bool, settings: ContactSettings = ContactSettings()):
+    """The two blocks with the top face pushed down and stretched laterally as the homogeneous uniaxial state asks;
+    the base held (all of it, or its bottom face). Returns the system, the exact state and node sets."""
+    mesh, _, _ = two_blocks((base_cells, base_cells, 2), (top_cells, top_cells, 2), gap_mm=GAP_MM)
+    em = element_mesh(mesh.points_mm * MM, mesh.tets, 2)
+    base_tets = 6 * base_cells**2 * 2
+    base, top = np.unique(em.elements[:base_tets]), np.unique(em.elements[base_tets:])
+    x = em.nodes_m
+    top_face = top[np.isclose(x[top, 2], (1 + GAP_MM) * MM, rtol=0, atol=1e-12)]
+    F = uniaxial(LAW, 1 - SQUEEZE_MM)[[1, 2, 0]][:, [1, 2, 0]]  # diag(s, s, stretch): the axis is z
+    exact = np.column_stack([(F[0, 0] - 1) * x[:, 0], (F[1, 1] - 1) * x[:, 1],
+                             (F[2, 2] - 1) * (x[:, 2] - GAP_MM * MM) - GAP_MM * MM])
+    held = base if rigid_base else base[np.isclose(x[base, 2], -MM, rtol=0, atol=1e-12)]
+    prescribed = np.union1d(top_face, held)
+    contact = FrictionlessContact.of(ContactSurface.of(em, mesh.boundary_faces, prescribed), LAW.shear_modulus_Pa,
+                                     settings)
+    system = Equilibrium.of(Solid.of(em, LAW), prescribed, top_face, 1e-10, contact=contact)
+    u0 = np.zeros_like(x)
+    u0[top] = exact[top]
+    return system, u0, exact, F, em, mesh, top
+
+
+def _consistent_load(em, mesh, z_mm: float) -> np.ndarray:
+    """The nodal loads of a unit pressure on the boundary faces at height z: the quadratic face's are 0 at its
+    corners and a third of its area at each midside node."""
+    load = np.zeros(len(em.nodes_m))
+    x = em.nodes_m
+    for face in mesh.boundary_faces[np.all(np.isclose(x[mesh.boundary_faces][:, :, 2], z_mm * MM, atol=1e-12), axis=1)]:
+        area = 0.5 * np.linalg.norm(np.cross(x[face[1]] - x[face[0]], x[face[2]] - x[face[0]]))
+        for i, j in ((0, 1), (1, 2), (2, 0)):
+            load[midside_nodes(em, face[[i]], face[[j]])[0]] += area / 3
+    return load
+
+
+@pytest.mark.parametrize("base_cells, top_cells", [(2, 2), (2, 3), (3, 2)])
+def test_patch_a_block_pressed_on_a_rigid_face_takes_the_uniform_pressure(base_cells, top_cells):
+    # conforming (2, 2) and non-conforming meshes: the contact forces on the block are the consistent loads of the
+    # closed-form pressure and the block's state the homogeneous one, to the augmented Lagrangian's penetration
+    system, u0, exact, F, em, mesh, top = _blocks(base_cells, top_cells, True, ContactSettings(penetration_tol_mm=1e-9,
+                                                                                            max_augmentations=60))
+    result = newton_augmented(system, u0)
+    assert result.status == "converged"
+    pressure = -neo_hooke_cauchy(LAW, F)[2, 2] * F[0, 0] * F[1, 1]  # per rest area
+    load = pressure * _consistent_load(em, mesh, GAP_MM)
+    bottom = np.flatnonzero(load > 0)
+    force = system.contact.forces(result.u)
+    assert np.abs(force[bottom, 2] + load[bottom]).max() < 1e-6 * load.max()  # measured 1.7e-7 to 3.1e-7
+    assert np.abs(force[:, :2]).max() < 1e-12 * load.max()  # frictionless: no tangential force at all
+    assert np.abs(result.u[top] - exact[top]).max() < 2e-7 * SQUEEZE_MM * MM  # measured 3.7e-8 to 4.8e-8
+    assert system.contact.summary(result.u).area_m2 == pytest.approx(MM**2, rel=1e-12)  # the 1 x 1 mm footprint
+
+
+def test_a_deformable_base_carries_the_same_total_load():
+    # both blocks elastic (the base's bottom held): the load's spread on the base's nodes is the flat facets'
+    # (linear), not the quadratic face's, so neither block is homogeneous and the quadratic faces cannot close on
+    # the flat facets at every Gauss point: on this conforming mesh the multiplier updates stall near 6 nm of
+    # penetration (17 nm at penalty factor 10), a limit of the formulation far below the default tolerance
+    system, u0, exact, F, em, mesh, top = _blocks(2, 2, False, ContactSettings(penalty_factor=30.0, penetration_tol_mm=2e-5,
+                                                                               max_augmentations=100))
+    result = newton_augmented(system, u0)
+    assert result.status == "converged"
+    reaction = -result.forces[system.reaction, 2].sum()
+    base_load = result.forces[np.isclose(em.nodes_m[:, 2], -MM, atol=1e-12), 2].sum()
+    assert reaction == pytest.approx(base_load, rel=1e-9)  # action and reaction across the contact: measured 1e-14
+
+
+def test_forces_and_tangent_are_the_derivatives_of_the_contact_energy():
+    system, u0, exact, F, em, mesh, top = _blocks(2, 3, True, ContactSettings(geometric_tangent=True))
+    contact = system.contact
+    rng = np.random.default_rng(1)
+    u = u0 + rng.normal(scale=2e-7, size=u0.shape)  # penetrating, by about 10 um
+    contact.multipliers_Pa = rng.uniform(0, 1e5, size=contact.multipliers_Pa.shape)
+    contact.assignment = contact.search(u)
+    f = contact.forces(u)
+    assert contact.active(u).shape[0] > 20
+    nodes, blocks = contact.tangent_blocks(u)
+    v = rng.normal(size=u.shape) * 1e-9
+    kv = np.zeros_like(u)
+    np.add.at(kv, nodes, np.einsum("pabij,pbj->pai", blocks, v[nodes]))
+    h = 1e-3
+    de = (contact.energy(u + h * v) - contact.energy(u - h * v)) / (2 * h)
+    assert de == pytest.approx(np.sum(f * v), rel=1e-7)
+    df = (contact.forces(u + h * v) - contact.forces(u - h * v)) / (2 * h)
+    assert np.abs(df - kv).max() < 1e-6 * np.abs(kv).max()
+
+
+def test_the_answer_does_not_depend_on_the_penalty():
+    reactions = []
+    for factor in (10.0, 30.0):  # measured: reactions 4e-8 apart
+        system, u0, *_ = _blocks(2, 3, False, ContactSettings(penalty_factor=factor, penetration_tol_mm=1e-8,
+                                                                  max_augmentations=100))
+        result = newton_augmented(system, u0)
+        assert result.status == "converged"
+        reactions.append(result.forces[system.reaction, 2].sum())
+    assert reactions[0] == pytest.approx(reactions[1], rel=1e-6)
+
+
+@pytest.mark.parametrize("key, value", [("penalty_factor", 0.0), ("penetration_tol_mm", -1e-3), ("search_mm", 0.0),
+                                        ("max_augmentations", 0)])
+def test_a_contact_setting_out_of_range_is_refused_naming_the_key(key, value):
+    with pytest.raises(ConfigError, match=key):
+        ContactSettings(**{key: value})
