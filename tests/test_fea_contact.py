@@ -11,7 +11,7 @@ from helpers_neo_hooke import neo_hooke_cauchy, uniaxial
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import ConfigError
-from seadesign.fea.contact import ContactSettings, ContactSurface, FrictionlessContact, plane_gap
+from seadesign.fea.contact import ContactSettings, ContactSurface, FrictionlessContact, Multipliers, plane_gap
 from seadesign.fea.elements import element_mesh, midside_nodes
 from seadesign.fea.equilibrium import Equilibrium
 from seadesign.fea.finite_strain import Solid
@@ -107,12 +107,13 @@ def test_a_deformable_base_carries_the_same_total_load():
 
 
 def test_forces_and_tangent_are_the_derivatives_of_the_contact_energy():
-    system, u0, exact, F, em, mesh, top = _blocks(2, 3, True, ContactSettings(geometric_tangent=True))
+    system, u0, exact, F, em, mesh, top = _blocks(2, 3, True, ContactSettings())
     contact = system.contact
     rng = np.random.default_rng(1)
     u = u0 + rng.normal(scale=2e-7, size=u0.shape)  # penetrating, by about 10 um
-    contact.multipliers_Pa = rng.uniform(0, 1e5, size=contact.multipliers_Pa.shape)
     contact.assignment = contact.search(u)
+    q, f = contact.assignment
+    contact.multipliers = Multipliers(q * len(contact.surface.facets) + f, rng.uniform(0, 1e5, size=len(q)))
     f = contact.forces(u)
     assert contact.active(u).shape[0] > 20
     nodes, blocks = contact.tangent_blocks(u)
@@ -124,6 +125,22 @@ def test_forces_and_tangent_are_the_derivatives_of_the_contact_energy():
     assert de == pytest.approx(np.sum(f * v), rel=1e-7)
     df = (contact.forces(u + h * v) - contact.forces(u - h * v)) / (2 * h)
     assert np.abs(df - kv).max() < 1e-6 * np.abs(kv).max()
+
+
+def test_the_first_pass_over_the_vertices_loses_no_pair_that_can_press():
+    """The search looks only at faces near a facing vertex (`near_mm`); with the blocks pressed and sheared
+    sideways by a random field, the pairs within 20 um (pressed or about to be) are those of a search over every
+    face (`near_mm` beyond the part)."""
+    system, u0, *_ = _blocks(2, 3, False)
+    u = u0 + np.random.default_rng(2).normal(scale=2e-6, size=u0.shape)
+    everywhere = FrictionlessContact.of(system.contact.surface, LAW.shear_modulus_Pa, ContactSettings(near_mm=100.0))
+
+    def close(contact):
+        pairs = contact.pairs(u, contact.search(u))
+        return set(zip(pairs.point[pairs.gap_m < 20e-6], pairs.facet[pairs.gap_m < 20e-6]))
+
+    found = close(system.contact)
+    assert len(found) > 40 and found == close(everywhere)
 
 
 def test_the_answer_does_not_depend_on_the_penalty():

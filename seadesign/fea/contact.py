@@ -39,16 +39,28 @@ class FacingSurfaces:
         x0 = self.nodes_m[self.vertices]
         x = x0 + u[self.vertices]
         n = vertex_normals(self.nodes_m + u, self.faces, self.vertices)
-        pairs = cKDTree(x).query_pairs(self.search_m, output_type="ndarray")
-        if len(pairs):
-            pairs = pairs[np.einsum("ij,ij->i", n[pairs[:, 0]], n[pairs[:, 1]]) < -0.5]
-        if len(pairs):
-            pairs = pairs[_gap(x0, self.rest_normals, pairs) > 0]
+        pairs = self._pairs(x, n, self.search_m, -0.5)
         if not len(pairs):
             return float("inf"), (float("nan"),) * 3
         gaps = _gap(x, n, pairs)
         k = int(np.argmin(gaps))
         return float(gaps[k] / MM), tuple(float(c) for c in x0[pairs[k]].mean(axis=0) / MM)
+
+    def facing_vertices(self, u: np.ndarray, distance_m: float, cosine: float) -> np.ndarray:
+        """The vertices (node ids) within `distance_m` of a vertex they face at u (normals' cosine below `cosine`,
+        a positive gap at rest)."""
+        x = self.nodes_m[self.vertices] + u[self.vertices]
+        return self.vertices[np.unique(self._pairs(x, vertex_normals(self.nodes_m + u, self.faces, self.vertices),
+                                                   distance_m, cosine))]
+
+    def _pairs(self, x: np.ndarray, n: np.ndarray, distance_m: float, cosine: float) -> np.ndarray:
+        """Vertex pairs (rows of `vertices`) within `distance_m` at positions x, normals n, that face each other."""
+        pairs = cKDTree(x).query_pairs(distance_m, output_type="ndarray")
+        if len(pairs):
+            pairs = pairs[np.einsum("ij,ij->i", n[pairs[:, 0]], n[pairs[:, 1]]) < cosine]
+        if len(pairs):
+            pairs = pairs[_gap(self.nodes_m[self.vertices], self.rest_normals, pairs) > 0]
+        return pairs
 
 
 def vertex_normals(x: np.ndarray, faces: np.ndarray, vertices: np.ndarray) -> np.ndarray:
@@ -76,6 +88,14 @@ _A, _B = 0.445948490915965, 0.091576213509771
 FACE_POINTS = np.array([[_A, _A, 1 - 2 * _A], [_A, 1 - 2 * _A, _A], [1 - 2 * _A, _A, _A],
                         [_B, _B, 1 - 2 * _B], [_B, 1 - 2 * _B, _B], [1 - 2 * _B, _B, _B]])
 FACE_WEIGHTS = np.array([0.223381589678011] * 3 + [0.109951743655322] * 3)
+# A point faces a facet when the cosine between its face's normal and the facet's is below this (more than 107
+# degrees apart): surfaces that close on each other meet nearly opposed; a wall beside a flat face (90 degrees)
+# is not paired with it, which keeps the search from pairing every side-wall point with the large top and
+# bottom facets of an extruded part
+FACING_COSINE = -0.3
+# The search's first pass pairs vertices whose (averaged) normals are more than 60 degrees apart: at an edge or
+# a corner a vertex's normal leans half-way to the side wall's
+NEAR_COSINE = 0.5
 
 
 def face_shape_values(lam: np.ndarray) -> np.ndarray:
@@ -123,21 +143,21 @@ class ContactSettings:
     shear modulus over the mean boundary edge length (Pa/m), multipliers updated until the largest
     penetration is below `penetration_tol_mm`, at most `max_augmentations` times an increment.
 
-    `geometric_tangent`: the tangent also carries the pressure's geometric part, - w t hess g, the exact second
-    derivative of the contact energy. On flat facets that part grows as the pressure over the facet's size (a
-    facet's rotation turns its force), a discretisation artefact that makes the tangent indefinite at creases,
-    where the path would read it as buckling; so by default the tangent keeps the normal stiffness w eps grad g
-    grad g only, and the quasi-Newton updates supply the rest."""
+    The tangent (`FrictionlessContact.tangent_blocks`) is the exact second derivative of the contact energy: the
+    normal stiffness w eps grad g grad g and the pressure's geometric part - w t hess g, without which Newton
+    converges only linearly once the contact carries load."""
 
-    penalty_factor: float = 10.0
+    penalty_factor: float = 100.0
     penetration_tol_mm: float = 0.0045  # 1 % of the default study's 0.45 mm fillet radius
     max_augmentations: int = 30
     search_mm: float = 0.1  # beyond a facet's reach (its largest centroid-to-corner distance), how far from its
     # centroid a point is paired with it: more than any gap that can carry pressure
-    geometric_tangent: bool = False
+    near_mm: float = 1.0  # the search looks only at faces with a corner vertex this close to a vertex it faces
+    # (`NEAR_COSINE`, a gap at rest: a cheap first pass over the vertices; above the in-plane size of the faces
+    # where surfaces close)
 
     def __post_init__(self) -> None:
-        for key in ("penalty_factor", "penetration_tol_mm", "search_mm"):
+        for key in ("penalty_factor", "penetration_tol_mm", "search_mm", "near_mm"):
             if not getattr(self, key) > 0:
                 raise ConfigError(f"contact setting {key} must be positive, got {getattr(self, key)!r}")
         if self.max_augmentations < 1:
@@ -179,9 +199,12 @@ class ContactSurface:
         return cls(x, faces, facets, (area[:, None] * FACE_WEIGHTS).ravel(), shape, _points(shape, x, faces), checked,
                    np.flatnonzero(np.repeat(checked, len(FACE_WEIGHTS))))
 
-    def points(self, u: np.ndarray) -> np.ndarray:
-        """(6k, 3) Gauss points (m) of the surface deformed by u."""
-        return _points(self.shape, self.nodes_m + u, self.faces)
+    def points(self, u: np.ndarray, which: np.ndarray | None = None) -> np.ndarray:
+        """(6k, 3) Gauss points (m) of the surface deformed by u; only those numbered `which` if given."""
+        if which is None:
+            return _points(self.shape, self.nodes_m + u, self.faces)
+        return np.einsum("pa,pai->pi", self.shape[which % len(FACE_WEIGHTS)],
+                         (self.nodes_m + u)[self.faces[which // len(FACE_WEIGHTS)]])
 
 
 def _points(shape: np.ndarray, x: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -213,18 +236,42 @@ class ContactSummary:
     penetration_m: float
 
 
+@dataclass(frozen=True)
+class Multipliers:
+    """The augmented Lagrangian's multipliers (Pa), one a (point, facet) pair, kept by the pair's key
+    point * facets + facet (sorted); a pair not kept has none."""
+
+    keys: np.ndarray
+    values_Pa: np.ndarray
+
+    @classmethod
+    def none(cls) -> "Multipliers":
+        return cls(np.empty(0, dtype=np.int64), np.empty(0))
+
+    def at(self, keys: np.ndarray) -> np.ndarray:
+        """The multipliers of the pairs `keys` (0 for a pair not kept)."""
+        if not len(self.keys):
+            return np.zeros(len(keys))
+        i = np.minimum(np.searchsorted(self.keys, keys), len(self.keys) - 1)
+        return np.where(self.keys[i] == keys, self.values_Pa[i], 0.0)
+
+
 @dataclass
 class FrictionlessContact:
-    """Frictionless self-contact of a part's boundary as an energy: each Gauss point of a face that faces a
-    flat facet across open space (normals more than 90 degrees apart now, the point in front of the
-    facet's plane at rest, the facet not on the point's face) stores w / (2 eps) (max(0, lam - eps g)^2 - lam^2)
-    with g its distance from the facet's plane, w its rest weight, eps the penalty (Pa/m) and lam its
-    multiplier (Pa): the contact pressure is max(0, lam - eps g). Exact forces and tangent of that energy."""
+    """Frictionless self-contact of a part's boundary as an energy: each Gauss point of a face, paired with every
+    flat facet it faces across open space (normals more than 107 degrees apart now: `FACING_COSINE`, the point in
+    front of the facet's plane at rest, the facet not on the point's face) and projects inside, stores
+    w / (2 eps) (max(0, lam - eps g)^2 - lam^2) with g its distance from the facet's plane, w its rest weight, eps
+    the penalty (Pa/m) and lam the pair's multiplier (Pa): the contact pressure is max(0, lam - eps g). Exact
+    forces and tangent of that energy. A point that projects inside two facets (the valley of a concave surface
+    or inside a ridge of a convex one) is pushed out of both planes: it penetrates where it is behind either
+    (a valley) or behind both (a ridge, seen from outside its prisms diverge)."""
 
     surface: ContactSurface
     settings: ContactSettings
     penalty_Pa_per_m: float
-    multipliers_Pa: np.ndarray = field(repr=False)
+    vertices: FacingSurfaces  # the surface's corner vertices, for the search's first pass
+    multipliers: Multipliers = field(repr=False)
     assignment: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)  # (points, facets): `search`
 
     @classmethod
@@ -232,25 +279,33 @@ class FrictionlessContact:
         edges = surface.nodes_m[surface.facets] - np.roll(surface.nodes_m[surface.facets], 1, axis=1)
         h = float(np.linalg.norm(edges, axis=2).mean())
         return cls(surface, settings, settings.penalty_factor * shear_modulus_Pa / h,
-                   np.zeros(len(surface.weights_m2)))
+                   FacingSurfaces.of(surface.nodes_m, surface.faces[:, :3], settings.near_mm), Multipliers.none())
 
     def search(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The Gauss points paired with facets at u (m): (points, facets). Assigned (`assignment`), the pairs hold
         until the next assignment, so that the contact energy is smooth in between: a point's gap is its distance
-        from its facet's plane, extended past the facet's edges. Candidates: a point within a facet's reach (its largest centroid-to-corner distance plus
+        from its facet's plane, extended past the facet's edges. Candidates, on the faces with a corner within
+        `near_mm` of a vertex it faces: a point within a facet's reach (its largest centroid-to-corner distance plus
         `search_mm`) of its centroid, the point in front of the facet's plane at rest, the point checked against
         the facet (see `ContactSurface`), the facet not touching the point's face; of these, a point is paired with
-        the nearest plane among the facets it projects inside whose normal is more than 90 degrees from its face's."""
+        each facet it projects inside whose normal faces its face's (`FACING_COSINE`)."""
         s = self.surface
+        near = np.isin(s.faces[:, :3], self.vertices.facing_vertices(u, self.settings.near_mm * MM, NEAR_COSINE))
+        near = near.any(axis=1)
+        if not near.any():
+            return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
         x = s.nodes_m + u
         xq = s.points(u)
-        tri = x[s.facets]
+        facets = np.flatnonzero(np.repeat(near, len(SUBFACETS)))
+        tri = x[s.facets[facets]]
         centroids = tri.mean(axis=1)
         reach = self.settings.search_mm * MM + np.linalg.norm(tri - centroids[:, None], axis=2).max(axis=1)
         n_facet = _unit(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]))
         corners = x[s.faces[:, :3]]
         n_face = _unit(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
-        q, f = _facing_candidates(xq, n_face, s.checked_points, centroids, n_facet, reach)
+        points = s.checked_points[near[s.checked_points // len(FACE_WEIGHTS)]]
+        q, f = _facing_candidates(xq, n_face, points, centroids, n_facet, reach)
+        f = facets[f]
         face, other = q // len(FACE_WEIGHTS), f // len(SUBFACETS)
         keep = s.checked[face] & (~s.checked[other] | (face < other))
         keep &= ~(s.faces[face][:, :, None] == s.facets[f][:, None, :]).any(axis=(1, 2))
@@ -261,11 +316,16 @@ class FrictionlessContact:
         q, f = q[ahead], f[ahead]
         gap, n, inside = self._planes(u, q, f)
         own = x[s.faces[q // len(FACE_WEIGHTS), :3]]
-        opposed = np.einsum("pi,pi->p", n, np.cross(own[:, 1] - own[:, 0], own[:, 2] - own[:, 0])) < 0
-        q, f, gap = q[opposed & inside], f[opposed & inside], gap[opposed & inside]
-        order = np.lexsort((np.abs(gap), q))  # per point, the nearest plane first
-        first = order[np.r_[True, q[order][1:] != q[order][:-1]]] if len(order) else order
-        return q[first], f[first]
+        opposed = np.einsum("pi,pi->p", n, _unit(np.cross(own[:, 1] - own[:, 0], own[:, 2] - own[:, 0]))) < FACING_COSINE
+        q, f = q[opposed & inside], f[opposed & inside]
+        order = np.argsort(q * len(s.facets) + f)
+        return q[order], f[order]
+
+    def with_pairs(self, assignment: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """The current assignment and `assignment` together (sorted by pair)."""
+        n = len(self.surface.facets)
+        keys = np.union1d(self.assignment[0] * n + self.assignment[1], assignment[0] * n + assignment[1])
+        return keys // n, keys % n
 
     def new_pairs(self, assignment: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """The pairs of `assignment` that the current assignment does not hold."""
@@ -278,7 +338,7 @@ class FrictionlessContact:
         points project inside the facets."""
         s = self.surface
         tri = (s.nodes_m + u)[s.facets[f]]
-        e1, e2, d = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], s.points(u)[q] - tri[:, 0]
+        e1, e2, d = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0], s.points(u, q) - tri[:, 0]
         n = _unit(np.cross(e1, e2))
         gap = np.einsum("pi,pi->p", d, n)
         return gap, n, _inside(d - gap[:, None] * n, e1, e2)
@@ -304,14 +364,16 @@ class FrictionlessContact:
         return np.column_stack([pairs.point[pressed], pairs.facet[pressed]])
 
     def pressure_Pa(self, pairs: ContactPairs) -> np.ndarray:
-        """max(0, lam - eps g) at the paired points (Pa)."""
-        return np.maximum(0.0, self.multipliers_Pa[pairs.point] - self.penalty_Pa_per_m * pairs.gap_m)
+        """max(0, lam - eps g) of the pairs (Pa)."""
+        lam = self.multipliers.at(pairs.point * len(self.surface.facets) + pairs.facet)
+        return np.maximum(0.0, lam - self.penalty_Pa_per_m * pairs.gap_m)
 
     def energy(self, u: np.ndarray) -> float:
         """The contact energy (J) at u."""
         pairs, eps, w = self.pairs(u), self.penalty_Pa_per_m, self.surface.weights_m2
         t = self.pressure_Pa(pairs)
-        return float(np.sum(w[pairs.point] * t**2) - np.sum(w * self.multipliers_Pa**2)) / (2 * eps)
+        held = w[self.multipliers.keys // len(self.surface.facets)] * self.multipliers.values_Pa**2
+        return float(np.sum(w[pairs.point] * t**2) - np.sum(held)) / (2 * eps)
 
     def forces(self, u: np.ndarray) -> np.ndarray:
         """(N, 3) nodal forces dW/du (N)."""
@@ -324,22 +386,30 @@ class FrictionlessContact:
             np.add.at(f, pairs.nodes[active], -(self.surface.weights_m2[pairs.point[active]] * t[active])[:, None, None] * grad)
         return f
 
-    def tangent_blocks(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The active pairs' nodes (P, 9) and their 9 x 9 tangent blocks (P, 9, 9, 3, 3) in N/m: w eps grad g grad g,
-        with `geometric_tangent` also - w t hess g."""
+    def tangent_blocks(self, u: np.ndarray, geometric: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """The assigned pairs' nodes (P, 9) and their 9 x 9 tangent blocks (P, 9, 9, 3, 3) in N/m: w eps grad g grad g
+        and, if `geometric`, - w t hess g; zero for a pair without pressure, so that the tangent's sparsity pattern
+        (and its factorization's ordering) holds while the assignment does.
+
+        Without the geometric part the blocks are positive semi-definite: the tangent on which the path judges
+        the part's stability (`Equilibrium.stability`). On flat facets that part grows as the pressure over
+        the facet's size (a facet's rotation turns its force); where a notch's flanks press together beyond
+        about the shear modulus it makes the tangent indefinite: the crease, a local surface instability of
+        the compressed rubber that is not a loss of the spring's load path."""
         pairs = self.pairs(u)
         t = self.pressure_Pa(pairs)
         a = t > 0
-        if not a.any():
-            return np.empty((0, 9), dtype=np.int64), np.empty((0, 9, 9, 3, 3))
-        y, c = self._variables(u, pairs, a)
-        _, grad_y, hess_y = plane_gap(*y)
-        grad = np.einsum("pia,pic->pac", c, grad_y)
-        w = self.surface.weights_m2[pairs.point[a]]
-        blocks = (w * self.penalty_Pa_per_m)[:, None, None, None, None] * grad[:, :, None, :, None] * grad[:, None, :, None, :]
-        if self.settings.geometric_tangent:
-            blocks -= (w * t[a])[:, None, None, None, None] * np.einsum("pia,pjb,pijkl->pabkl", c, c, hess_y)
-        return pairs.nodes[a], blocks
+        blocks = np.zeros((len(t), 9, 9, 3, 3))
+        if a.any():
+            y, c = self._variables(u, pairs, a)
+            _, grad_y, hess_y = plane_gap(*y)
+            grad = np.einsum("pia,pic->pac", c, grad_y)
+            w = self.surface.weights_m2[pairs.point[a]]
+            k = (w * self.penalty_Pa_per_m)[:, None, None, None, None] * grad[:, :, None, :, None] * grad[:, None, :, None, :]
+            if geometric:
+                k -= (w * t[a])[:, None, None, None, None] * np.einsum("pia,pjb,pijkl->pabkl", c, c, hess_y)
+            blocks[a] = k
+        return pairs.nodes, blocks
 
     def summary(self, u: np.ndarray) -> ContactSummary:
         """The contact at u: area under pressure, its peak and where, the pairs' moment about z, the penetration."""
@@ -349,19 +419,20 @@ class FrictionlessContact:
         if not a.any():
             return ContactSummary(0.0, 0.0, (float("nan"),) * 3, 0.0, 0.0)
         w = self.surface.weights_m2[pairs.point[a]]
-        x = self.surface.points(u)[pairs.point[a]]
+        x = self.surface.points(u, pairs.point[a])
         force = -(w * t[a])[:, None] * self._gradient(u, pairs, a)[:, :6].sum(axis=1)  # on the checked points' faces
         moment = np.abs(x[:, 0] * force[:, 1] - x[:, 1] * force[:, 0]).sum()
         k = int(np.argmax(t[a]))
         at = tuple(float(c) for c in self.surface.rest_points_m[pairs.point[a][k]] / MM)
-        return ContactSummary(float(w.sum()), float(t[a][k]), at, float(moment), float(max(0.0, -pairs.gap_m[a].min())))
+        area = self.surface.weights_m2[np.unique(pairs.point[a])].sum()  # a point pressed on two facets counts once
+        return ContactSummary(float(area), float(t[a][k]), at, float(moment), float(max(0.0, -pairs.gap_m[a].min())))
 
     def augment(self, u: np.ndarray) -> None:
-        """Multipliers <- the pressures at u (Uzawa's update); points without a facet carry none."""
+        """Multipliers <- the pairs' pressures at u (Uzawa's update); pairs no longer assigned carry none."""
         pairs = self.pairs(u)
-        lam = np.zeros_like(self.multipliers_Pa)
-        lam[pairs.point] = self.pressure_Pa(pairs)
-        self.multipliers_Pa = lam
+        keys = pairs.point * len(self.surface.facets) + pairs.facet
+        order = np.argsort(keys)
+        self.multipliers = Multipliers(keys[order], self.pressure_Pa(pairs)[order])
 
     def penetration_m(self, u: np.ndarray, assignment: tuple[np.ndarray, np.ndarray] | None = None) -> float:
         """The largest penetration (m) of a point under pressure at u, 0 without one (pairs as in `pairs`)."""
@@ -382,9 +453,9 @@ class FrictionlessContact:
 def _facing_candidates(xq: np.ndarray, n_face: np.ndarray, points: np.ndarray, centroids: np.ndarray,
                        n_facet: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(point, facet) pairs, among `points`, within each facet's reach of its centroid with the point's face normal
-    opposed to the facet's (cosine below 0), and some more. The search is in (position, a x normal): there an
-    opposed pair within the reach r lies within sqrt(r^2 + 2 a^2), two points of one smooth surface (normals alike)
-    2 a apart, further for a >= r. Facets are searched in classes of reach doubling from the smallest, a = the
+    opposed to the facet's (cosine c below `FACING_COSINE`), and some more. The search is in (position, a x normal):
+    there such a pair within the reach r lies within sqrt(r^2 + 2 a^2 (1 + c)), two points of one smooth surface
+    (normals alike) 2 a apart, further for a >= r. Facets are searched in classes of reach doubling from the smallest, a = the
     class's largest reach, so that a large facet does not pull in its surface's neighbours."""
     classes = np.floor(np.log2(reach / reach.min())).astype(np.int64)
     found_q, found_f = [], []
@@ -392,7 +463,7 @@ def _facing_candidates(xq: np.ndarray, n_face: np.ndarray, points: np.ndarray, c
         facets = np.flatnonzero(classes == c)
         a = float(reach[facets].max())
         tree = cKDTree(np.hstack([xq[points], -a * n_face[points // len(FACE_WEIGHTS)]]))
-        near = tree.query_ball_point(np.hstack([centroids[facets], a * n_facet[facets]]), np.sqrt(reach[facets]**2 + 2 * a**2))
+        near = tree.query_ball_point(np.hstack([centroids[facets], a * n_facet[facets]]), np.sqrt(reach[facets]**2 + 2 * a**2 * (1 + FACING_COSINE)))
         counts = np.fromiter(map(len, near), dtype=np.int64, count=len(near))
         if counts.sum():
             found_q.append(points[np.concatenate(near).astype(np.int64)])

@@ -74,11 +74,32 @@ class Equilibrium:
 
     def factor(self, u: np.ndarray) -> Pardiso:
         """LDL^T factorization of the free-node tangent at u; NotPositiveDefinite when its inertia counts a
-        negative eigenvalue (the state has lost stability). The inertia is exact, where a Cholesky
-        factorization near a singular point may or may not meet its negative pivot."""
+        negative eigenvalue (the state has lost stability) and no contact carries pressure: with contact the
+        consistent tangent may be indefinite at a crease, and `stability` judges. The inertia is exact, where a
+        Cholesky factorization near a singular point may or may not meet its negative pivot."""
+        self._factor(u, geometric=True)
+        if not self._pressed(u) and self.pardiso.inertia()[1] > 0:
+            raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
+        return self.pardiso
+
+    def stability(self, u: np.ndarray) -> None:
+        """NotPositiveDefinite unless the tangent at u is positive definite, the contact counted by its normal
+        stiffness only (see `FrictionlessContact.tangent_blocks`): buckling of the part with its contacts as
+        constraints. Refactors only when contact carries pressure (else `factor` has judged); call `factor` after."""
+        if self._pressed(u):
+            self._factor(u, geometric=False)
+            if self.pardiso.inertia()[1] > 0:
+                raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
+
+    def _pressed(self, u: np.ndarray) -> bool:
+        """Whether contact carries pressure at u."""
+        return self.contact is not None and len(self.contact.active(u)) > 0
+
+    def _factor(self, u: np.ndarray, geometric: bool) -> None:
+        """Factor the tangent at u (the contact's geometric part if `geometric`)."""
         k = self.solid.tangent(u, self.pattern)
         if self.contact is not None:
-            nodes, blocks = self.contact.tangent_blocks(u)
+            nodes, blocks = self.contact.tangent_blocks(u, geometric)
             if len(nodes):
                 k = add_pair_blocks(k, self.node_index, nodes, blocks)
         self._hold(k)
@@ -89,9 +110,6 @@ class Equilibrium:
             self.close()
             self.pardiso = Pardiso(k, indefinite=True)
         self.factorizations += 1
-        if self.pardiso.inertia()[1] > 0:
-            raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
-        return self.pardiso
 
     def _hold(self, k) -> None:
         """Held degrees of freedom: zero rows and columns, unit diagonal (in place)."""

@@ -36,7 +36,9 @@ def newton_augmented(system: Equilibrium, u0: np.ndarray, settings: NewtonSettin
     """`newton` with the contact pairs searched at u0 and held (the contact search once an increment); then, while
     the solution penetrates further than the contact's tolerance, Uzawa's update of the contact multipliers and
     `newton` again: the augmented Lagrangian. Penetration is also measured on the pairs searched afresh at the
-    solution; where those penetrate beyond the tolerance (a point the held pairs missed), they are assigned first.
+    solution; where those penetrate beyond the tolerance (a point the held pairs missed), they join the held ones
+    (which stay: a point that slid out of its facet's prism keeps its plane until the next increment, so that
+    the assignment cannot cycle).
     The residual norms of all the solves; status "penetrating" when `max_augmentations` rounds did not bring the
     penetration within the tolerance."""
     contact = system.contact
@@ -50,7 +52,7 @@ def newton_augmented(system: Equilibrium, u0: np.ndarray, settings: NewtonSettin
         fresh = contact.search(result.u)
         missed = contact.penetration_m(result.u, contact.new_pairs(fresh)) > tol
         if missed:
-            contact.assignment = fresh
+            contact.assignment = contact.with_pairs(fresh)
         depth = contact.penetration_m(result.u)
         if depth <= tol:
             return NewtonResult(result.u, result.forces, norms, "converged", depth, k)
