@@ -1,12 +1,13 @@
 """Frictionless contact against independent references: PyTorch's automatic derivatives of the gap, finite
-differences of the contact energy, and the contact patch test (a block pressed onto a flat face takes the closed-
-form homogeneous uniaxial state of the neo-Hookean law, helpers_neo_hooke) on conforming and non-conforming meshes."""
+differences of the contact energy, the contact patch test (a block pressed onto a flat face takes the closed-form
+homogeneous uniaxial state of the neo-Hookean law, helpers_neo_hooke) on conforming and non-conforming meshes, and
+Hertz's cylinder on a flat."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers_contact import two_blocks
+from helpers_contact import half_cylinder_on_flat, two_blocks
 from helpers_neo_hooke import neo_hooke_cauchy, uniaxial
 
 from seadesign.design.materials import Hyperelastic
@@ -159,3 +160,49 @@ def test_the_answer_does_not_depend_on_the_penalty():
 def test_a_contact_setting_out_of_range_is_refused_naming_the_key(key, value):
     with pytest.raises(ConfigError, match=key):
         ContactSettings(**{key: value})
+
+
+def _hertz(h_mm: float) -> tuple[float, float]:
+    """A neo-Hookean half cylinder (R = 10 mm, plane strain: u_z = 0) whose top face is pushed 0.05 mm down onto a
+    rigid flat: the contact half-width and peak pressure relative to Hertz's for the measured line load,
+    a = sqrt(4 P R / (pi E*)) and p0 = 2 P / (pi a) with E* = E / (1 - nu^2), minus 1. The finite-element pair is
+    read from the pressures of the pressed Gauss points by the least-squares fit of p^2 = p0^2 (1 - x^2 / a^2) to
+    those above a fifth of the largest (a single Gauss point's pressure oscillates, see the test)."""
+    radius_mm, thickness_mm, push_mm = 10.0, 0.1, 0.05
+    mesh, flat = half_cylinder_on_flat(radius_mm, thickness_mm, h_mm)
+    em = element_mesh(mesh.points_mm * MM, mesh.tets, 2)
+    x = em.nodes_m
+    top = np.flatnonzero(np.isclose(x[:, 1], 0.0, rtol=0, atol=1e-12))
+    prescribed = np.union1d(np.unique(em.elements[np.isin(em.elements[:, :4], flat).all(axis=1)]), top)
+    contact = FrictionlessContact.of(ContactSurface.of(em, mesh.boundary_faces, prescribed), LAW.shear_modulus_Pa,
+                                     ContactSettings(penetration_tol_mm=1e-5))
+    system = Equilibrium.of(Solid.of(em, LAW), prescribed, top, 1e-9, held_z=np.arange(len(x)), contact=contact)
+    cylinder = np.setdiff1d(np.arange(len(x)), prescribed)
+    u0 = np.zeros_like(x)
+    u0[top, 1] = -push_mm * MM
+    u0[cylinder, 1] = -push_mm * MM * (1 + x[cylinder, 1] / (radius_mm * MM))
+    result = newton_augmented(system, u0)
+    assert result.status == "converged"
+    line_load = -result.forces[top, 1].sum() / (thickness_mm * MM)  # N/m
+    e_star = 10e6 / (1 - 0.45**2)
+    a_hertz = np.sqrt(4 * line_load * radius_mm * MM / (np.pi * e_star))
+    pairs = contact.pairs(result.u)
+    p = contact.pressure_Pa(pairs)
+    xq = contact.surface.points(result.u, pairs.point)[:, 0]
+    fit = p > 0.2 * p.max()
+    c0, c1 = np.linalg.lstsq(np.column_stack([np.ones(fit.sum()), xq[fit] ** 2]), p[fit] ** 2, rcond=None)[0]
+    p0, a = np.sqrt(c0), np.sqrt(-c0 / c1)
+    assert p.max() < 1.06 * p0  # a Gauss point's own pressure: within 5 % of the fit's peak (measured 4.6 %)
+    return a / a_hertz - 1, p0 / (2 * line_load / (np.pi * a_hertz)) - 1
+
+
+def test_hertz_a_cylinder_pressed_on_a_flat():
+    # h = 0.05 mm, about 11 elements across the half-width a = 0.54 mm (a / R = 0.054); 7.4k tetrahedra
+    width, peak = _hertz(0.05)
+    assert abs(width) < 0.02 and abs(peak) < 0.02  # measured -1.24 % and +0.50 %
+
+
+@pytest.mark.slow
+def test_hertz_converges_on_refinement():
+    coarse, fine = _hertz(0.05), _hertz(0.025)  # measured (-1.24 %, +0.50 %) then (-1.17 %, -0.20 %)
+    assert abs(fine[0]) < abs(coarse[0]) and abs(fine[1]) < abs(coarse[1])
