@@ -113,3 +113,29 @@ def test_calibration_errors_name_the_key(tmp_path):
     (tmp_path / "c.json").write_text(json.dumps({"youngs_modulus_Pa": -1}))
     with pytest.raises(ConfigError, match="'youngs_modulus_Pa' must be a positive number"):
         sd.apply_calibration(sd.load_study(), tmp_path / "c.json")
+
+
+def test_the_exploration_result_as_a_table_and_a_plot():
+    """`ExplorationResult.to_frame` and `plot` on an evaluated table made here: the search's unit-cube columns
+    dropped, the choice flagged, and each design drawn once in its series."""
+    from types import SimpleNamespace
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from seadesign.explore.pipeline import ExplorationResult
+
+    evaluated = pd.DataFrame({"x0": [0.1, 0.5, 0.9, 0.3], "x1": [0.2, 0.4, 0.6, 0.8], "candidate": list("abcd"),
+                              "mass_g": [30.0, 25.0, 40.0, 35.0], "total_violation": [0.0, 0.2, 0.0, 0.5],
+                              "front": [True, True, False, False], "x_offset_mm": [1.0, 2.0, 3.0, 4.0]})
+    run = SimpleNamespace(exploration=SimpleNamespace(evaluated=evaluated), decision=SimpleNamespace(index=0),
+                          problem=SimpleNamespace(objectives=("mass_g",)))
+    result = ExplorationResult(SimpleNamespace(name="tiny"), run, None, {})
+    t = result.to_frame()
+    assert list(t.columns) == ["candidate", "mass_g", "total_violation", "front", "x_offset_mm", "chosen"]
+    assert t["chosen"].tolist() == [True, False, False, False]
+    assert "x0" in evaluated.columns  # a copy: the exploration's own table keeps its columns
+    ax = result.plot()
+    series = {line.get_label(): line.get_xydata().tolist() for line in ax.get_lines()}
+    assert series == {"evaluated": [[40.0, 0.0], [35.0, 0.5]], "front": [[30.0, 0.0], [25.0, 0.2]],
+                      "chosen": [[30.0, 0.0]]}
