@@ -32,6 +32,8 @@ _ENTRY_POINTS = {
     "train": ("seadesign.corrector.pipeline", "train"),
     "evaluate": ("seadesign.corrector.pipeline", "evaluate"),
     "explain": ("seadesign.loop.explain_file", "explain_file"),
+    "simulate": ("seadesign.twin.pipeline", "simulate_walk"),
+    "simulate_bench": ("seadesign.twin.pipeline", "simulate_bench_test"),
     "Study": ("seadesign.design.study", "Study"),
     "Candidate": ("seadesign.design.candidate", "Candidate"),
     "Material": ("seadesign.design.materials", "Material"),

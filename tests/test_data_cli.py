@@ -29,3 +29,34 @@ def test_simulate_inspect_clean_bench(tmp_path, spring_file):
     assert len(read_bench(tmp_path / "b.csv")) == 1000
     r = run(main, ["simulate", "--spring", str(spring_file), "--effect", "nope", "-o", str(tmp_path / "x.csv")])
     assert r.exit_code == 2 and "no effect named 'nope'" in r.output
+
+
+def test_the_api_simulates_what_the_commands_write(tmp_path, spring_file, spring_dict):
+    """`sd.simulate` and `sd.simulate_bench` give the tables the commands write (read back from their files),
+    from the spring's file or its content."""
+    import numpy as np
+
+    import seadesign as sd
+
+    out = tmp_path / "walk.csv"
+    r = CliRunner().invoke(main, ["simulate", "--spring", str(spring_file), "--ground", "--seed", "3", "--rate-hz",
+                                  "50", "--trial-duration-s", "1", "--effect", "hysteresis:torque_Nm=0.2", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    written = read_recording(out)
+    table, meta = sd.simulate(spring_dict, ground=True, seed=3, rate_hz=50.0, trial_duration_s=1.0,
+                              effects=("hysteresis:torque_Nm=0.2",))
+    assert len(table) == len(written) == 18 * 50 and "spring_file" not in meta
+    columns = [c for c in written.columns if c in table.columns and np.issubdtype(written[c].dtype, np.number)]
+    assert {"l_hall_pos", "r_knee_pos", "l_knee_eff"} <= set(columns)
+    np.testing.assert_allclose(table[columns].to_numpy(float), written[columns].to_numpy(float), rtol=1e-9, atol=1e-9)
+    assert meta["effects_enabled"] == written.attrs["metadata"]["effects_enabled"]
+
+    out = tmp_path / "bench.csv"
+    r = CliRunner().invoke(main, ["simulate-bench", "--spring", str(spring_file), "--profile", "ramp", "--duration-s",
+                                  "4", "--seed", "1", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    table, meta = sd.simulate_bench(spring_file, profile="ramp", duration_s=4.0, seed=1)
+    written = read_bench(out)
+    np.testing.assert_allclose(table[["torque_Nm", "deflection_rad"]].to_numpy(), written[["torque_Nm", "deflection_rad"]]
+                               .to_numpy(), rtol=1e-9, atol=1e-12)
+    assert meta["spring_file"] == str(spring_file) == written.attrs["metadata"]["spring_file"]

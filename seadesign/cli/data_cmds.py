@@ -21,17 +21,8 @@ from seadesign.data import (
 )
 from seadesign.data.artefacts import Thresholds
 from seadesign.effects import EffectChain
-from seadesign.design.spring import load_spring, torque_curve
-from seadesign.twin import (
-    BenchProtocol,
-    KneeConfig,
-    KneeSession,
-    bench_effects,
-    configure_chain,
-    knee_effects,
-    simulate_bench,
-    thesis_protocol,
-)
+from seadesign.twin import KneeConfig, bench_effects, knee_effects
+from seadesign.twin.pipeline import simulate_bench_test, simulate_walk
 
 EFFECT_HELP = ("Switch or set an effect: NAME (on), NAME=off, or NAME:param=value,... (parameter units as listed "
                "by `seadesign effects`); repeatable.")
@@ -104,16 +95,10 @@ def clean_cmd(file: Path, output: Path, pressure_threshold: float, keep_lifted: 
 def simulate(spring_path: Path, protocol: str, ground: bool, seed: int, rate_hz: float, trial_duration_s: float,
              repeats: int, effects: tuple[str, ...], output: Path) -> None:
     """Simulate both knees of the robot walking the protocol with the spring in --spring."""
-    spring = load_spring(spring_path)
-    cfg = KneeConfig.from_spring(spring)
-    chain = configure_chain(knee_effects(cfg, ground), list(effects))
-    session = KneeSession(spring, thesis_protocol(trial_duration_s, repeats), ground=ground, rate_hz=rate_hz,
-                          seed=seed, effects=chain, config=cfg)
-    df = session.run()
-    meta = session.metadata()
-    meta["spring_file"] = str(spring_path)
+    df, meta = simulate_walk(spring_path, ground=ground, seed=seed, rate_hz=rate_hz, trial_duration_s=trial_duration_s,
+                             repeats=repeats, effects=effects)
     write_recording(df, output, meta)
-    click.echo(f"wrote {output}: {len(df)} rows, {len(session.trials)} trials, effects on: "
+    click.echo(f"wrote {output}: {len(df)} rows, {len(meta['trials'])} trials, effects on: "
                f"{', '.join(meta['effects_enabled'])}")
 
 
@@ -135,11 +120,9 @@ def simulate(spring_path: Path, protocol: str, ground: bool, seed: int, rate_hz:
 def simulate_bench_cmd(spring_path: Path, profile: str, torque_amplitude_nm: float, frequency_hz: float,
                        duration_s: float, rate_hz: float, seed: int, effects: tuple[str, ...], output: Path) -> None:
     """Simulate a torque-deflection bench test of the spring in --spring."""
-    spring = load_spring(spring_path)
-    chain = configure_chain(bench_effects(spring["k_Nm_per_rad"], torque_curve(spring)), list(effects))
-    protocol = BenchProtocol(profile, torque_amplitude_nm, frequency_hz, duration_s, rate_hz)
-    df, meta = simulate_bench(spring, protocol, effects=chain, seed=seed)
-    meta["spring_file"] = str(spring_path)
+    df, meta = simulate_bench_test(spring_path, profile=profile, torque_amplitude_Nm=torque_amplitude_nm,
+                                   frequency_hz=frequency_hz, duration_s=duration_s, rate_hz=rate_hz, seed=seed,
+                                   effects=effects)
     write_bench(df, output, meta)
     click.echo(f"wrote {output}: {len(df)} rows, effects on: {', '.join(meta['effects_enabled'])}")
 
