@@ -206,3 +206,20 @@ def test_hertz_a_cylinder_pressed_on_a_flat():
 def test_hertz_converges_on_refinement():
     coarse, fine = _hertz(0.05), _hertz(0.025)  # measured (-1.24 %, +0.50 %) then (-1.17 %, -0.20 %)
     assert abs(fine[0]) < abs(coarse[0]) and abs(fine[1]) < abs(coarse[1])
+
+
+def test_stability_is_judged_on_the_normal_stiffness_where_contact_presses():
+    """`Equilibrium.stability` refactors the tangent (solid and the contact's normal stiffness, positive definite
+    here) only where contact carries pressure; `factor` then gives the full tangent, whose solve is Newton's."""
+    system, u0, *_ = _blocks(2, 2, True)
+    apart = np.zeros_like(u0)
+    system.contact.assignment = system.contact.search(apart)
+    before = system.factorizations
+    system.stability(apart)  # no pressure: nothing to judge beyond `factor`
+    assert system.factorizations == before
+    result = newton_augmented(system, u0)
+    before = system.factorizations
+    system.stability(result.u)
+    assert system.factorizations == before + 1 and system.pardiso.inertia()[1] == 0
+    full, normal = (system.contact.tangent_blocks(result.u, geometric) for geometric in (True, False))
+    assert np.abs(full[1] - normal[1]).max() > 0  # the pressure's geometric part is there, and left out
