@@ -77,8 +77,8 @@ class Equilibrium:
         negative eigenvalue (the state has lost stability) and no contact carries pressure: with contact the
         consistent tangent may be indefinite at a crease, and `stability` judges. The inertia is exact, where a
         Cholesky factorization near a singular point may or may not meet its negative pivot."""
-        self._factor(u, geometric=True)
-        if not self._pressed(u) and self.pardiso.inertia()[1] > 0:
+        pressed = self._factor(u, geometric=True)
+        if not pressed and self.pardiso.inertia()[1] > 0:
             raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
         return self.pardiso
 
@@ -95,11 +95,14 @@ class Equilibrium:
         """Whether contact carries pressure at u."""
         return self.contact is not None and len(self.contact.active(u)) > 0
 
-    def _factor(self, u: np.ndarray, geometric: bool) -> None:
-        """Factor the tangent at u (the contact's geometric part if `geometric`)."""
+    def _factor(self, u: np.ndarray, geometric: bool) -> bool:
+        """Factor the tangent at u (the contact's geometric part if `geometric`); whether contact presses there
+        (a pair without pressure has a zero block)."""
         k = self.solid.tangent(u, self.pattern)
+        pressed = False
         if self.contact is not None:
             nodes, blocks = self.contact.tangent_blocks(u, geometric)
+            pressed = bool(np.any(blocks))
             if len(nodes):
                 k = add_pair_blocks(k, self.node_index, nodes, blocks)
         self._hold(k)
@@ -110,6 +113,7 @@ class Equilibrium:
             self.close()
             self.pardiso = Pardiso(k, indefinite=True)
         self.factorizations += 1
+        return pressed
 
     def _hold(self, k) -> None:
         """Held degrees of freedom: zero rows and columns, unit diagonal (in place)."""
