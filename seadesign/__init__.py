@@ -34,6 +34,8 @@ _ENTRY_POINTS = {
     "explain": ("seadesign.loop.explain_file", "explain_file"),
     "simulate": ("seadesign.twin.pipeline", "simulate_walk"),
     "simulate_bench": ("seadesign.twin.pipeline", "simulate_bench_test"),
+    "inspect_recording": ("seadesign.data.pipeline", "inspect_recording"),
+    "clean_recording": ("seadesign.data.pipeline", "clean_recording"),
     "Study": ("seadesign.design.study", "Study"),
     "Candidate": ("seadesign.design.candidate", "Candidate"),
     "Material": ("seadesign.design.materials", "Material"),
@@ -43,6 +45,7 @@ _ENTRY_POINTS = {
     "ExplorationResult": ("seadesign.explore.pipeline", "ExplorationResult"),
     "TrainedCorrector": ("seadesign.corrector.pipeline", "TrainedCorrector"),
     "FileExplanation": ("seadesign.loop.explain_file", "FileExplanation"),
+    "Thresholds": ("seadesign.data.artefacts", "Thresholds"),
     "SeadesignError": ("seadesign.errors", "SeadesignError"),
     "ConfigError": ("seadesign.errors", "ConfigError"),
 }

@@ -60,3 +60,34 @@ def test_the_api_simulates_what_the_commands_write(tmp_path, spring_file, spring
     np.testing.assert_allclose(table[["torque_Nm", "deflection_rad"]].to_numpy(), written[["torque_Nm", "deflection_rad"]]
                                .to_numpy(), rtol=1e-9, atol=1e-12)
     assert meta["spring_file"] == str(spring_file) == written.attrs["metadata"]["spring_file"]
+
+
+def test_the_api_inspects_and_cleans_what_the_commands_write(tmp_path, spring_file):
+    """`sd.inspect_recording` gives the report `data inspect --json` writes, and `sd.clean_recording` the table
+    `data clean` writes (read back from the files)."""
+    import numpy as np
+    import pandas as pd
+
+    import seadesign as sd
+
+    run = CliRunner().invoke
+    out = tmp_path / "sim.csv"
+    r = run(main, ["simulate", "--spring", str(spring_file), "--ground", "--seed", "4", "--rate-hz", "50",
+                   "--trial-duration-s", "1", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    r = run(main, ["data", "inspect", str(out), "--step-threshold", "0.2", "--plot", str(tmp_path / "p.png"),
+                   "--json", str(tmp_path / "r.json")])
+    assert r.exit_code == 0, r.output
+    inspection = sd.inspect_recording(out, sd.Thresholds(step_threshold=0.2))
+    assert json.loads(json.dumps(inspection.report.to_dict())) == json.loads((tmp_path / "r.json").read_text())
+    assert inspection.report.format() in r.output
+    assert inspection.plot(tmp_path / "api.png").stat().st_size > 0
+
+    r = run(main, ["data", "clean", str(out), "-o", str(tmp_path / "c.csv"), "--positive", "--no-normalise"])
+    assert r.exit_code == 0, r.output
+    result = sd.clean_recording(out, positive=True, normalise=False)
+    written = pd.read_csv(tmp_path / "c.csv")
+    assert list(written.columns) == list(result.table.columns) and len(written) == len(result.table) > 0
+    numeric = [c for c in written.columns if np.issubdtype(written[c].dtype, np.number)]
+    np.testing.assert_allclose(result.table[numeric].to_numpy(float), written[numeric].to_numpy(float), rtol=1e-12)
+    assert result.format() in r.output

@@ -10,16 +10,9 @@ import click
 
 from seadesign import constants as C
 from seadesign.cli import main
-from seadesign.data import (
-    clean,
-    detect_artefacts,
-    plot_recording,
-    read_recording,
-    write_bench,
-    write_cleaned,
-    write_recording,
-)
+from seadesign.data import write_bench, write_cleaned, write_recording
 from seadesign.data.artefacts import Thresholds
+from seadesign.data.pipeline import clean_recording, inspect_recording
 from seadesign.effects import EffectChain
 from seadesign.twin import KneeConfig, bench_effects, knee_effects
 from seadesign.twin.pipeline import simulate_bench_test, simulate_walk
@@ -45,13 +38,11 @@ def data() -> None:
               help="A gap is a sample interval above this multiple of the median interval (dimensionless).")
 def inspect(file: Path, plot_path: Path | None, json_path: Path | None, step_threshold: float, gap_factor: float) -> None:
     """Report the artefacts of a robot recording FILE per knee and plot them."""
-    df = read_recording(file)
-    report = detect_artefacts(df, Thresholds(step_threshold=step_threshold, gap_factor=gap_factor))
-    click.echo(report.format())
-    png = plot_recording(df, report, plot_path or Path(f"{file.stem}_inspect.png"))
-    click.echo(f"plot: {png}")
+    inspection = inspect_recording(file, Thresholds(step_threshold=step_threshold, gap_factor=gap_factor))
+    click.echo(inspection.report.format())
+    click.echo(f"plot: {inspection.plot(plot_path or Path(f'{file.stem}_inspect.png'))}")
     if json_path:
-        json_path.write_text(json.dumps(report.to_dict(), indent=2) + "\n")
+        json_path.write_text(json.dumps(inspection.report.to_dict(), indent=2) + "\n")
         click.echo(f"report: {json_path}")
 
 
@@ -71,7 +62,7 @@ def inspect(file: Path, plot_path: Path | None, json_path: Path | None, step_thr
 def clean_cmd(file: Path, output: Path, pressure_threshold: float, keep_lifted: bool, keep_artefacts: bool,
               no_unwrap: bool, no_offset: bool, no_normalise: bool, positive: bool) -> None:
     """Clean a robot recording FILE as in the thesis, logging every step and removed row."""
-    result = clean(read_recording(file), pressure_threshold=pressure_threshold, keep_lifted=keep_lifted,
+    result = clean_recording(file, pressure_threshold=pressure_threshold, keep_lifted=keep_lifted,
                    drop_artefacts=not keep_artefacts, unwrap=not no_unwrap, remove_offset=not no_offset,
                    normalise=not no_normalise, positive=positive)
     click.echo(result.format())

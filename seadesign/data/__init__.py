@@ -13,6 +13,8 @@ Public API (stable):
 - `clean(df, ...) -> CleanResult` with the cleaned table and the step log (`cleaning.py`);
   `write_cleaned(result, path)` writes it flat with a sidecar (log, removed rows, units).
 - `plot_recording(df, report, path)`: the inspection plot (`plots.py`).
+- `inspect_recording(path)`, `clean_recording(path, ...)`: `data inspect` and `data clean` from a file
+  (`pipeline.py`, imported from there: it is the API's layer, `sd.inspect_recording`).
 
 Every malformed input raises `seadesign.errors.DataError` naming line, row and column.
 """
