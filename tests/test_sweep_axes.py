@@ -107,7 +107,7 @@ def test_ranges_continuous_bounds_and_a_material_axis(tmp_path):
     assert axes["beam_count"].values == (3, 5, 7)
     assert axes["arc_radius_mm"].continuous and axes["arc_radius_mm"].bounds == (4.5, 6.0)
     assert axes["material"].values == ("ninjaflex", "cheetah")
-    with pytest.raises(ValueError, match="continuous axes"):
+    with pytest.raises(ConfigError, match="continuous axes"):
         study.candidates()
     c = study.candidate(arc_radius_mm=5.123456789, beam_count=5, beam_thickness_mm=6.0, material="cheetah")
     assert c.params.arc_radius_mm == 5.123456789  # exact in the geometry (and so in every cache key)

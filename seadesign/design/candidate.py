@@ -44,16 +44,38 @@ class Candidate:
 
     @property
     def checked(self) -> bool:
+        """Whether the validity checks have run (`Study.check`)."""
         return self.reasons is not None
 
     @property
     def valid(self) -> bool:
+        """Whether the checked candidate passed every validity check; ValueError before it is checked."""
         if self.reasons is None:
             raise ValueError(f"candidate {self.name} has not been checked yet")
         return not self.reasons
 
     def with_geometry(self, reasons: tuple[str, ...], volume_mm3: float) -> "Candidate":
-        """This candidate checked: its validity reasons, volume (mm^3) and mass (kg, from its material)."""
+        """This candidate checked: its validity reasons, volume and mass (from its material's density).
+
+        Parameters
+        ----------
+        reasons : tuple of str
+            Why the candidate is invalid; empty: valid.
+        volume_mm3 : float
+            The solid's volume (mm^3).
+
+        Returns
+        -------
+        Candidate
+            A copy with ``reasons``, ``volume_mm3`` and ``mass_kg`` (kg) set.
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> cand = sd.load_study("wolfgang_knee").candidate(beam_count=6, beam_thickness_mm=8.0)
+        >>> round(cand.with_geometry((), 22000.0).mass_kg, 4)
+        0.0262
+        """
         return replace(self, reasons=tuple(reasons), volume_mm3=float(volume_mm3),
                        mass_kg=float(volume_mm3) * 1e-9 * self.material.density_kg_per_m3)
 

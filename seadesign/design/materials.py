@@ -68,6 +68,7 @@ class Hyperelastic:
 
     @property
     def shear_modulus_Pa(self) -> float:
+        """Small-strain shear modulus E / (2 (1 + nu)) (Pa)."""
         """The initial shear modulus mu = 2 (C10 + C01) (Pa)."""
         return 2.0 * (self.c10_Pa + self.c01_Pa)
 
@@ -109,16 +110,55 @@ class Material:
 
     def strain_limits(self, safety_factor: float) -> StrainLimits:
         """The allowable tensile strains: the cyclic limit as sourced (no factor: the source's limit is already
-        one for repeated loading) and elongation at yield / safety factor for a single event; None unsourced."""
+        one for repeated loading) and elongation at yield / safety factor for a single event.
+
+        Parameters
+        ----------
+        safety_factor : float
+            Divides the elongation at yield (dimensionless, >= 1; the study's ``[strength] safety_factor``).
+
+        Returns
+        -------
+        StrainLimits
+            ``cyclic`` and ``single`` (event) tensile engineering strains (0.43 = 43 %); None where the material file
+            has no sourced value (the verdict is then "not judged").
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> sd.load_material("ninjaflex").strain_limits(1.5)
+        StrainLimits(cyclic=None, single=0.43333333333333335)
+        """
         single = None if self.elongation_at_yield is None else self.elongation_at_yield / safety_factor
         return StrainLimits(self.cyclic_strain_limit, single)
 
     @property
     def shear_modulus_Pa(self) -> float:
+        """Small-strain shear modulus E / (2 (1 + nu)) (Pa)."""
         return self.youngs_modulus_Pa / (2.0 * (1.0 + self.poisson_ratio))
 
     def scaled(self, stiffness_scale: float, note: str) -> "Material":
-        """The same material with every modulus multiplied by `stiffness_scale` (a calibration result)."""
+        """The same material with every modulus multiplied by `stiffness_scale` (a calibration result).
+
+        Parameters
+        ----------
+        stiffness_scale : float
+            Factor on E and on the hyperelastic law's moduli (dimensionless, > 0).
+        note : str
+            Where the scale comes from; added to the name and the sources.
+
+        Returns
+        -------
+        Material
+            A copy; this material is unchanged.
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> soft = sd.load_material("ninjaflex").scaled(0.5, "bench test 2026-11-20")
+        >>> soft.youngs_modulus_Pa
+        6000000.0
+        """
         h, s = self.hyperelastic, stiffness_scale
         hyper = None if h is None else replace(
             h, c10_Pa=h.c10_Pa * s, c01_Pa=h.c01_Pa * s, c20_Pa=h.c20_Pa * s, c30_Pa=h.c30_Pa * s,
@@ -128,7 +168,19 @@ class Material:
                        sources=tuple(tuple(x) for x in self.sources) + (("youngs_modulus", note),), hyperelastic=hyper)
 
     def to_handoff(self) -> dict:
-        """The material block of spring.json."""
+        """The material block of spring.json.
+
+        Returns
+        -------
+        dict
+            ``name``, ``youngs_modulus_Pa``, ``poisson_ratio``, ``density_kg_per_m3``, ``yield_strength_Pa``.
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> sd.load_material("ninjaflex").to_handoff()["youngs_modulus_Pa"]
+        12000000.0
+        """
         return {
             "name": self.key,
             "youngs_modulus_Pa": self.youngs_modulus_Pa,

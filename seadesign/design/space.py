@@ -18,6 +18,7 @@ import re
 from dataclasses import dataclass
 
 from seadesign.design.tomlcheck import Table
+from seadesign.errors import ConfigError
 
 Value = int | float | str
 MATERIAL_KEY = "material"
@@ -149,7 +150,8 @@ def grid(axes: tuple[Axis, ...]) -> list[tuple[tuple[str, Value], ...]]:
     """Every combination of axis values, the first axis varying fastest (discrete axes only)."""
     continuous = [a.key for a in axes if a.continuous]
     if continuous:
-        raise ValueError(f"the continuous axes {continuous} have no grid; explore them, or give values or a step")
+        raise ConfigError(f"the continuous axes {continuous} have no grid; explore them (`seadesign explore`), or give "
+                          "each of them values or a step in [design_space]")
     combos = itertools.product(*(a.values for a in reversed(axes)))
     return [tuple(zip((a.key for a in axes), reversed(c))) for c in combos]
 

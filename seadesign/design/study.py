@@ -146,16 +146,74 @@ class Study:
         return next(iter(self.materials.values()))
 
     def with_materials(self, materials: dict[str, Material]) -> "Study":
-        """The same study with other material data under the same names (e.g. a calibrated modulus)."""
+        """The same study with other material data under the same names (e.g. a calibrated modulus).
+
+        Parameters
+        ----------
+        materials : dict of str to Material
+            Material key -> the material data to use under that key.
+
+        Returns
+        -------
+        Study
+            A copy; this study is unchanged.
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> study = sd.load_study("wolfgang_knee")
+        >>> soft = study.with_materials({"ninjaflex": study.material.scaled(0.5, "bench test")})
+        """
         return dataclasses.replace(self, materials={**self.materials, **materials})
 
     def candidates(self) -> list[Candidate]:
-        """Every combination of the discrete axes' values, the first axis varying fastest."""
+        """Every combination of the discrete axes' values, the first axis varying fastest.
+
+        Returns
+        -------
+        list of Candidate
+            Unchecked candidates (see `check`).
+
+        Raises
+        ------
+        ConfigError
+            A design axis is continuous (an explorer study): it has no grid.
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> [c.name for c in sd.load_study("wolfgang_knee").candidates()][:2]
+        ['3 beams x 4 mm', '4 beams x 4 mm']
+        """
         return [self._candidate(values) for values in grid(self.axes)]
 
     def candidate(self, *values: Value, **by_key: Value) -> Candidate:
-        """The candidate with these axis values, in axis order or by key (dotted keys by `**{}`);
-        a value outside the study's design space is refused, naming the axes."""
+        """The candidate with these axis values, in axis order or by key (dotted keys by `**{}`).
+
+        Parameters
+        ----------
+        *values : float, int or str
+            Axis values in the study's axis order (lengths in mm, as the axis key says).
+        **by_key : float, int or str
+            Axis values by key, e.g. ``beam_count=6, beam_thickness_mm=8.0``.
+
+        Returns
+        -------
+        Candidate
+            Unchecked (see `check`).
+
+        Raises
+        ------
+        ConfigError
+            An axis is missing, unknown, or its value is outside the study's design space; the message names the
+            axes and their values.
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> sd.load_study("wolfgang_knee").candidate(beam_count=6, beam_thickness_mm=8.0).name
+        '6 beams x 8 mm'
+        """
         keys = [a.key for a in self.axes]
         if len(values) > len(keys) or set(by_key) - set(keys):
             raise ConfigError(f"study '{self.name}' has the design axes {keys}; got values {list(values)} "
@@ -171,11 +229,57 @@ class Study:
         return self._candidate(tuple((k, given[k]) for k in keys))
 
     def check(self, candidate: Candidate) -> tuple[Candidate, "Part"]:
-        """Build and check a candidate with this study's validity rules (mass from its material)."""
+        """Build a candidate's solid with CadQuery and check it with this study's validity rules.
+
+        Parameters
+        ----------
+        candidate : Candidate
+            One of this study's candidates.
+
+        Returns
+        -------
+        Candidate
+            The candidate checked: its validity reasons (none: valid), volume (mm^3) and mass (kg).
+        Part
+            The CAD part (its solid, and its volume in mm^3).
+
+        A solid CadQuery cannot build is not raised: it comes back invalid, with the failure among its reasons.
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> study = sd.load_study("wolfgang_knee")
+        >>> checked, part = study.check(study.candidate(beam_count=6, beam_thickness_mm=8.0))
+        >>> checked.valid, round(checked.mass_kg * 1e3, 1)
+        (True, 28.3)
+        """
         return check_candidate(candidate, self.validity)
 
     def candidate_of_row(self, row) -> Candidate:
-        """The candidate a results-table row (one column per axis) belongs to."""
+        """The candidate a results-table row belongs to.
+
+        Parameters
+        ----------
+        row : mapping or pandas.Series
+            A row with one column per design axis (as ``results.csv`` and ``SweepResult.to_frame()`` hold).
+
+        Returns
+        -------
+        Candidate
+            Unchecked.
+
+        Raises
+        ------
+        ConfigError
+            The row's values are outside the study's design space.
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> study = sd.load_study("wolfgang_knee")
+        >>> study.candidate_of_row({"beam_count": 6, "beam_thickness_mm": 8.0}).name
+        '6 beams x 8 mm'
+        """
         return self.candidate(**{a.key: row[a.key] if a.key == MATERIAL_KEY else
                                  (float if a.continuous else type(a.values[0]))(row[a.key]) for a in self.axes})
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from seadesign.design.spring import load_spring, torque_curve
+from seadesign.design.spring import load_spring, torque_curve, validate_spring
 from seadesign.twin.bench import BenchProtocol, simulate_bench
 from seadesign.twin.config import KneeConfig, bench_effects, configure_chain, knee_effects
 from seadesign.twin.knee import KneeSession
@@ -21,7 +21,7 @@ def _spring(spring: str | Path | dict[str, Any]) -> tuple[dict[str, Any], dict[s
     """The spring's content, and the metadata entry naming its file (none for a dict)."""
     if isinstance(spring, (str, Path)):
         return load_spring(spring), {"spring_file": str(spring)}
-    return spring, {}
+    return validate_spring(spring, "the spring given"), {}
 
 
 def simulate_walk(spring: str | Path | dict[str, Any], *, ground: bool = False, seed: int = 0, rate_hz: float = 100.0,
@@ -52,6 +52,13 @@ def simulate_walk(spring: str | Path | dict[str, Any], *, ground: bool = False, 
         The recording in the robot format's columns.
     dict
         Its metadata: settings, versions, seed, trials, every effect (on and off) and the spring file.
+
+    Raises
+    ------
+    SpringFileError
+        The spring is missing or does not match the spring.json schema (the message names the field).
+    ConfigError
+        An effect or its parameter is unknown or out of range.
 
     Examples
     --------
@@ -98,6 +105,13 @@ def simulate_bench_test(spring: str | Path | dict[str, Any], *, profile: str = "
         ``time_s``, ``torque_Nm``, ``deflection_rad``.
     dict
         Its metadata: settings, every effect and the spring file.
+
+    Raises
+    ------
+    SpringFileError
+        The spring is missing or does not match the spring.json schema (the message names the field).
+    ConfigError
+        An unknown profile, or an effect or its parameter unknown or out of range.
 
     Examples
     --------
