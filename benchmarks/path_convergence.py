@@ -14,15 +14,17 @@ finest. Contact and strain peaks sit at beam roots (fillets), so they converge m
 at the end the path mesh's largest overestimate of those torques against the finest mesh over every candidate
 and level: the knock-down the sweep applies to the path's strain-limit torques (`sweep.requirements.
 STRAIN_TORQUE_KNOCKDOWN`).
+
+`--docs` writes the table against the finest mesh (docs/validation/_fragments/path_convergence.md) and, with
+`--strain-levels`, the torques at each strain level (strain_knockdown.md).
 """
 
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 
 import numpy as np
+from record import Table, add_docs_option, machine, write_fragment
 
 from seadesign.design.study import load_study
 from seadesign.fea.large_deflection import large_deflection
@@ -63,6 +65,7 @@ def main() -> None:
                                                            "(for a study with continuous axes)")
     ap.add_argument("--max-step-rad", type=float, default=PathSettings().max_step_rad,
                     help="the path's largest step (rad): smaller steps check that no narrow instability is stepped over")
+    add_docs_option(ap, "path_convergence", "strain_knockdown")
     args = ap.parse_args()
     settings = PathSettings(max_step_rad=args.max_step_rad)
     st = load_study(args.study)
@@ -71,8 +74,13 @@ def main() -> None:
     rotations = [float(r) for r in args.rotations.split(",")]
     levels = [float(x) for x in args.strain_levels.split(",") if x]
     ratios = []  # (candidate, level, path-mesh torque / finest-mesh torque)
-    print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
+    print(f"machine: {machine()}")
     print(f"study {st.name}, path settings {settings}")
+    convergence = Table(["design", "mesh", "dofs", f"T at {' / '.join(f'{r:g}' for r in rotations)} rad (Nm)",
+                         "stop (rad, Nm)", "single-event strain limit passed at (Nm)",
+                         f"peak tensile strain at {rotations[0]:g} rad", "time (s)"])
+    knockdown = Table(["design", f"torque (Nm) at tensile strain {' / '.join(f'{x:g}' for x in levels)}, path mesh",
+                       f"mesh {meshes[-1]}", f"path / mesh {meshes[-1]}"])
     specs = [args.study_candidate] if args.study_candidate else args.candidates.split(",")
     for spec in specs:
         if args.study_candidate:
@@ -112,12 +120,37 @@ def main() -> None:
         print("  against the finest:")
         for row in rows:
             _print_row(row, rows[-1])
+            convergence.add(candidate.name, row[0], f"{row[1]:,}", *_cells(row, rows[-1]))
+        if levels and "path" in at_levels and meshes[-1] != "path":
+            path_t, fine_t = at_levels["path"], at_levels[meshes[-1]]
+            knockdown.add(candidate.name, " / ".join(f"{v:.4g}" for v in path_t),
+                          " / ".join(f"{v:.4g}" for v in fine_t),
+                          " / ".join(f"{a / b:.4f}" if np.isfinite(a / b) else "-" for a, b in zip(path_t, fine_t)))
     if ratios:
         name, level, worst = max(ratios, key=lambda r: r[2])
         print("\npath mesh / finest mesh, torque at each tensile strain: " + "; ".join(
             f"{n} at {x:g}: {r:.4f}" for n, x, r in ratios))
         print(f"largest path-mesh overestimate: {name} at strain {level:g}: x {worst:.4f}; knock-down on the path's "
               f"strain-limit torques: {min(1.0, 1.0 / worst):.4f}")
+    if args.docs:
+        settings_text = (f"Study {st.name}; meshes {args.meshes} (a number: that coarsening of the study's mesh, 1 the "
+                         f"result mesh; path: the sweep's path mesh); largest step {settings.max_step_rad:g} rad")
+        write_fragment("path_convergence", convergence, settings_text,
+                       f"In brackets: the difference to mesh {meshes[-1]}.")
+        if knockdown.rows:
+            write_fragment("strain_knockdown", knockdown, settings_text)
+
+
+def _cells(row, ref) -> list[str]:
+    """The table's cells of a mesh's row, each with its difference to `ref`'s."""
+    c, dofs, torques, reason, stop_rad, stop_Nm, limit_Nm, strain, secs = row
+
+    def rel(v, r):
+        return f"{v:.4g} ({(v - r) / r:+.1%})" if np.isfinite(v) and np.isfinite(r) else f"{v:.4g}"
+
+    return [" / ".join(rel(v, r) for v, r in zip(torques, ref[2])),
+            f"{reason} at {rel(stop_rad, ref[4])}, {rel(stop_Nm, ref[5])}", rel(limit_Nm, ref[6]), rel(strain, ref[7]),
+            f"{secs:.0f}"]
 
 
 def _print_row(row, ref) -> None:
