@@ -9,17 +9,17 @@ study's default mesh), whether the peak converges, the extrapolated k,
 the observed order, each size's estimated discretization error, and the sweep's two-level
 estimate at the default (default vs the 1.5x coarser mesh) next to it; with --spread N, N fresh
 pytetwild meshes of the first candidate at the study's size and the spread (max - min) / mean of k.
+`--docs` writes the k table into docs/validation/_fragments/mesh_convergence_linear.md.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import tempfile
 import time
 
 import numpy as np
+from record import Table, add_docs_option, machine, write_fragment
 
 from seadesign.fea.convergence import richardson
 from seadesign.fea.loadcases import analyse
@@ -49,10 +49,14 @@ def main() -> None:
     ap.add_argument("--refinements", default="0.667,1,1.5,2.25", help="factors on the study's mesh density")
     ap.add_argument("--backend", choices=["gmsh", "pytetwild"], default="gmsh")
     ap.add_argument("--spread", type=int, default=0, help="fresh pytetwild meshings for the spread of k")
+    add_docs_option(ap, "mesh_convergence_linear")
     args = ap.parse_args()
     st = load_study(args.study)
     refinements = [float(s) for s in args.refinements.split(",")]
-    print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}, python {platform.python_version()}")
+    print(f"machine: {machine()}")
+    docs = Table(["design", "k at refinement " + " / ".join(f"{f:g}" for f in refinements) + " (Nm/rad)",
+                  "extrapolated k (Nm/rad)", "observed order", "error at the default mesh",
+                  "peak stall von Mises at each refinement (MPa)"])
     print(f"study {st.name}, material {st.material.name}, backend {args.backend}, study default "
           f"{st.mesh.elements_across_beam:g} elements across the beam, {st.mesh.elements_per_circle:g} per turn "
           f"on curved surfaces")
@@ -87,6 +91,9 @@ def main() -> None:
             print(f"Richardson (finest three): k0 = {r['extrapolated']:.5f} Nm/rad, observed order {r['order']:.2f}")
             for f, h, k in zip(refinements, hs, ks):
                 print(f"  refinement {f:g}: error against k0 {100 * (k - r['extrapolated']) / r['extrapolated']:+.2f} %")
+            default = (f"{(ks[refinements.index(1.0)] / r['extrapolated'] - 1):+.2%}" if 1.0 in refinements else "-")
+            docs.add(f"{n} beams x {w:g} mm", " / ".join(f"{k:.3f}" for k in ks), f"{r['extrapolated']:.3f}",
+                     f"{r['order']:.2f}", default, " / ".join(f"{v:.3g}" for v in peaks))
             coarse = round(1 / COARSENING, 3)
             if 1.0 in refinements and coarse in [round(f, 3) for f in refinements]:
                 k1 = ks[refinements.index(1.0)]
@@ -105,6 +112,11 @@ def main() -> None:
             ks = np.array(ks)
             print(f"spread of k over {len(ks)} fresh pytetwild meshes ({n} beams / {w:g} mm): "
                   f"{100 * np.ptp(ks) / ks.mean():.2f} % (max - min) / mean")
+    if args.docs and docs.rows:
+        write_fragment("mesh_convergence_linear", docs, f"Study {st.name}, material {st.material.name}, mesher "
+                       f"{args.backend}; refinement: a factor on the study's mesh density (1: the default mesh, "
+                       f"{st.mesh.elements_across_beam:g} elements across the beam); Richardson extrapolation over "
+                       "the finest three")
 
 
 if __name__ == "__main__":

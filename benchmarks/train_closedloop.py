@@ -13,13 +13,14 @@ NumPy, TorchScript; 1 thread), then the default's wall time (family 1 + fine-tun
     python benchmarks/closed_loop_goal.py OUT/reference-ilc OUT/closedloop-scratch OUT/closedloop --spring SPRING
 
     python benchmarks/train_closedloop.py [--spring studies/thesis_measured_spring.json] [--out DIR] [--threads 1]
+        [--docs]
+
+`--docs` writes the runs' table into docs/validation/_fragments/closedloop_training.md.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -36,6 +37,7 @@ from seadesign.corrector.runtime import STEP_BUDGET_US
 from seadesign.corrector.workflow import export_closedloop_bundle, train_closedloop_bundle, train_reference_bundle
 from seadesign.design.spring import load_spring
 from seadesign.onnx_corrector import load_onnx
+from record import Table, add_docs_option, machine, write_fragment
 
 THESIS_SPRING = Path(__file__).resolve().parents[1] / "studies" / "thesis_measured_spring.json"
 
@@ -73,13 +75,22 @@ def _paths_us(bundle: Path, calls: int) -> dict[str, float]:
     return {"onnx": _median_us(lambda: onnx(z), calls), "numpy": _median_us(lambda: npc(z), calls), "torchscript": ts_us}
 
 
-def _row(name: str, res: ClosedLoopResult, k: float, calls: int) -> str:
+COLUMNS = ["run", "learning rate", "epochs", "best epoch", "stop", "wall time (s)", "simulated batch steps/s",
+           "BPTT steps/s", "validation mean abs Hall error (rad)", "feedback bound (rad/rad)", "control step (us)"]
+
+
+def _row(name: str, res: ClosedLoopResult, k: float, calls: int) -> list[str]:
+    """The run's cells, in COLUMNS's order."""
     bptt_s = sum(row["bptt_s"] for row in res.curve)
     step_us = _step_us(runtime_corrector(res.policy, k), calls)
-    return (f"{name:<22} {res.settings.lr:>6g} {len(res.curve) - 1:>6} {res.best_epoch:>5} {res.stopped:>10} "
-            f"{res.wall_s:>7.1f} {res.simulated_steps / res.wall_s:>8.0f} {res.trained_steps / bptt_s:>12.0f} "
-            f"{res.curve[res.best_epoch]['val_mean_abs_error_rad']:>11.4f} {res.policy.feedback_lipschitz_bound():>7.3f} "
-            f"{step_us:>7.1f}")
+    return [name, f"{res.settings.lr:g}", f"{len(res.curve) - 1}", f"{res.best_epoch}", res.stopped, f"{res.wall_s:.1f}",
+            f"{res.simulated_steps / res.wall_s:.0f}", f"{res.trained_steps / bptt_s:.0f}",
+            f"{res.curve[res.best_epoch]['val_mean_abs_error_rad']:.4f}", f"{res.policy.feedback_lipschitz_bound():.3f}",
+            f"{step_us:.1f}"]
+
+
+def _print(cells: list[str]) -> None:
+    print(f"{cells[0]:<22} " + " ".join(f"{c:>10}" for c in cells[1:]), flush=True)
 
 
 def main() -> None:
@@ -88,34 +99,38 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("exports") / "benchmark_closedloop", help="bundles go here")
     ap.add_argument("--threads", type=int, default=1, help="torch intra-op threads for family-2 training")
     ap.add_argument("--calls", type=int, default=3000, help="runtime latency: command calls timed")
+    add_docs_option(ap, "closedloop_training")
     args = ap.parse_args()
     spring = load_spring(args.spring)
     k = spring["k_Nm_per_rad"]
     base = ClosedLoopSettings(threads=args.threads)
     knees = (len(base.directions) * (len(base.speeds) + len(base.val_speeds)) * len(base.settings)
              * len(base.k_scales) * 2)
-    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores, {platform.processor() or '?'}, "
-          f"load average {os.getloadavg()[0]:.1f}; python {platform.python_version()}, torch {torch.__version__}, "
-          f"numpy {np.__version__}, seadesign {__version__}; spring {args.spring} (k {k:.4g} Nm/rad)")
-    print(f"family 2: {len(base.directions)} directions x speeds {base.speeds} (training) and {base.val_speeds} "
-          f"(validation), {base.trial_s:g} s trials, {' and '.join(base.settings)}, k x {base.k_scales}, noise on, "
-          f"float64 knee; windows of {base.window_steps} samples, feedback Lipschitz bound "
-          f"{base.lipschitz_rad_per_rad} rad/rad, command-rate weight {base.rate_weight_s2:g} s^2; stop: < "
-          f"{base.min_improvement:.0%} for {base.patience} epochs (cap {base.max_seconds:g} s); threads {args.threads}; "
-          f"batch {knees} knees (steps/s: samples of the batch)", flush=True)
+    print(f"machine: {machine()}; torch {torch.__version__}, seadesign {__version__}; spring {args.spring} "
+          f"(k {k:.4g} Nm/rad)")
+    settings = (f"Family 2: {len(base.directions)} directions x speeds {base.speeds} (training) and {base.val_speeds} "
+                f"(validation), {base.trial_s:g} s trials, {' and '.join(base.settings)}, k x {base.k_scales}, noise on, "
+                f"float64 knee; windows of {base.window_steps} samples, feedback Lipschitz bound "
+                f"{base.lipschitz_rad_per_rad} rad/rad, command-rate weight {base.rate_weight_s2:g} s^2; stop: < "
+                f"{base.min_improvement:.0%} for {base.patience} epochs (cap {base.max_seconds:g} s); threads "
+                f"{args.threads}; batch {knees} knees (steps/s: samples of the batch)")
+    print(settings, flush=True)
+    table = Table(COLUMNS)
     _, family1, _ = train_reference_bundle(args.spring, args.out / "reference-ilc")
     family1_s = family1.label_s + family1.training.summary()["wall_s"]
     print(f"family 1: ILC labels {family1.label_s:.1f} s + network {family1.training.summary()['wall_s']:.1f} s = "
           f"{family1_s:.0f} s -> {args.out / 'reference-ilc'}", flush=True)
-    print(f"{'run':<22} {'lr':>6} {'epochs':>6} {'best':>5} {'stop':>10} {'wall_s':>7} {'steps/s':>8} "
-          f"{'bptt steps/s':>12} {'val_err_rad':>11} {'L_bound':>7} {'step_us':>7}")
+    table.add("family 1: ILC labels + network", "", "", "", "", f"{family1_s:.0f}", "", "", "", "", "")
+    print(" | ".join(COLUMNS))
     _, tuned, _ = train_closedloop_bundle(args.spring, args.out / "closedloop", replace(FINE_TUNING, threads=args.threads),
                                           family1=family1)
-    print(_row("fine-tuned (default)", tuned, k, args.calls), flush=True)
+    table.add(*_row("family 2 fine-tuning family 1 (default)", tuned, k, args.calls))
+    _print(table.rows[-1])
     scratch = train_closed_loop(spring, base)
     export_closedloop_bundle(scratch, args.spring, args.out / "closedloop-scratch", {"init": "scratch"},
                              name="closedloop-scratch")
-    print(_row("scratch", scratch, k, args.calls))
+    table.add(*_row("family 2 from scratch", scratch, k, args.calls))
+    _print(table.rows[-1])
     paths = _paths_us(args.out / "closedloop", args.calls)
     print("default bundle, one call of the flat forward (median): " + ", ".join(f"{p} {us:.1f} us" for p, us in
                                                                               paths.items())
@@ -123,6 +138,10 @@ def main() -> None:
     print(f"default `seadesign train` (family 1, then fine-tuned): {family1_s + tuned.wall_s:.0f} s to a converged "
           f"family-2 corrector; from scratch {scratch.wall_s:.0f} s. Bundles in {args.out}. Other processes share "
           "this CPU.")
+    if args.docs:
+        write_fragment("closedloop_training", table, settings + f"; spring {args.spring}",
+                       "Default bundle, one call of the flat forward (median): " + ", ".join(
+                           f"{p} {us:.1f} us" for p, us in paths.items()) + ".")
 
 
 if __name__ == "__main__":
