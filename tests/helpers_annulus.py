@@ -61,3 +61,33 @@ def annulus_peak_shear_Pa(a_mm: float, h_mm: float, torque_Nm: float) -> float:
     """Peak shear stress T / (2 pi a^2 h) at the bore."""
     a, h = a_mm * 1e-3, h_mm * 1e-3
     return torque_Nm / (2 * math.pi * a**2 * h)
+
+
+# Rivlin's circular shear of a neo-Hookean annulus (radii A_MM, B_MM, height H_MM, modulus E in Pa), plane strain
+A_MM, B_MM, H_MM, E = 10.0, 20.0, 4.0, 12e6
+
+
+def circular_shear(n_r: int, n_theta: int, nu: float, formulation: str):
+    """(path, T1, mu): the path to the torque T1 (Nm) of 1 rad in Rivlin's solution, faces held axially (u_z = 0,
+    plane strain), on an n_r x n_theta annulus; mu the shear modulus (Pa)."""
+    from seadesign.design.materials import Hyperelastic
+    from seadesign.fea.rotation_path import PathSettings, rotation_path
+    from seadesign.fea.torsion import MM
+
+    mesh = annulus_mesh(A_MM, B_MM, H_MM, n_r, n_theta, 1)
+    z = mesh.points_mm[mesh.boundary_faces][:, :, 2]
+    faces = mesh.boundary_faces[np.all(z < 1e-6, axis=1) | np.all(z > H_MM - 1e-6, axis=1)]
+    mu = E / (2 * (1 + nu))
+    t1 = 4 * np.pi * mu * H_MM * MM / ((A_MM * MM) ** -2 - (B_MM * MM) ** -2)  # T at phi(a) = 1 rad
+    path = rotation_path(mesh, Hyperelastic.from_linear(E, nu), 1.001 * t1, PathSettings(max_step_rad=0.25),
+                         axially_held_faces=faces, formulation=formulation)
+    return path, t1, mu
+
+
+def radial_drift(path) -> np.ndarray:
+    """|r' - r| of every vertex over the hub's arc at the last rotation (dimensionless)."""
+    from seadesign.fea.torsion import MM
+
+    x0, u = path.emesh.nodes_m[: path.emesh.n_vertices], path.displacement_m[: path.emesh.n_vertices]
+    dr = np.hypot(*(x0 + u)[:, :2].T) - np.hypot(*x0[:, :2].T)
+    return np.abs(dr) / (A_MM * MM * path.points[-1].rotation_rad)

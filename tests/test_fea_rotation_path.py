@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse.linalg as sla
-from helpers_annulus import annulus_mesh
+from helpers_annulus import E, H_MM, annulus_mesh, circular_shear, radial_drift
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.fea.assembly import stiffness_upper
@@ -16,42 +16,20 @@ from seadesign.fea.linsolve import full_from_upper
 from seadesign.fea.rotation_path import PathSettings, path_problem, rotation_path
 from seadesign.fea.torsion import MM
 
-A_MM, B_MM, H_MM, E = 10.0, 20.0, 4.0, 12e6
-
-
-def _circular_shear(n_r: int, n_theta: int, nu: float, formulation: str):
-    """Path to the torque of 1 rad in Rivlin's solution, faces held axially (u_z = 0, plane strain)."""
-    mesh = annulus_mesh(A_MM, B_MM, H_MM, n_r, n_theta, 1)
-    z = mesh.points_mm[mesh.boundary_faces][:, :, 2]
-    faces = mesh.boundary_faces[np.all(z < 1e-6, axis=1) | np.all(z > H_MM - 1e-6, axis=1)]
-    mu = E / (2 * (1 + nu))
-    t1 = 4 * np.pi * mu * H_MM * MM / ((A_MM * MM) ** -2 - (B_MM * MM) ** -2)  # T at phi(a) = 1 rad
-    path = rotation_path(mesh, Hyperelastic.from_linear(E, nu), 1.001 * t1, PathSettings(max_step_rad=0.25),
-                         axially_held_faces=faces, formulation=formulation)
-    return path, t1, mu
-
-
-def _radial_drift(path) -> np.ndarray:
-    """|r' - r| of every vertex over the hub's arc at the last rotation."""
-    x0, u = path.emesh.nodes_m[: path.emesh.n_vertices], path.displacement_m[: path.emesh.n_vertices]
-    dr = np.hypot(*(x0 + u)[:, :2].T) - np.hypot(*x0[:, :2].T)
-    return np.abs(dr) / (A_MM * MM * path.points[-1].rotation_rad)
-
-
 def test_circular_shear_torque_stays_linear_to_one_radian():
     # Rivlin: phi(a) = T / (4 pi mu h) (1/a^2 - 1/b^2) at any rotation (the shear response of neo-Hooke is linear)
-    path, t1, _ = _circular_shear(4, 48, 0.4999, "mean_dilatation")
+    path, t1, _ = circular_shear(4, 48, 0.4999, "mean_dilatation")
     assert path.stop_reason == "target_reached"
     assert path.rotation_at(t1) == pytest.approx(1.0, abs=0.01)  # measured 0.9964 on this coarse mesh
     for p in path.points[1:]:
         assert p.torque_Nm == pytest.approx(t1 * p.rotation_rad, rel=0.01)
-    assert _radial_drift(path).max() < 0.01  # measured 0.0044 (0.0011 on 10 x 120, second order)
+    assert radial_drift(path).max() < 0.01  # measured 0.0044 (0.0011 on 10 x 120, second order)
 
 
 def test_full_integration_locks_near_incompressibility():
     # the displacement-only P2 element with U(J) at every point is 7 % too stiff at 1 rad for nu = 0.4999;
     # the mean dilatation (one pressure per element) is not: the formulation that keeps P2 free of locking
-    path, t1, _ = _circular_shear(4, 48, 0.4999, "full")
+    path, t1, _ = circular_shear(4, 48, 0.4999, "full")
     assert path.rotation_at(t1) < 0.97  # measured 0.942
 
 
@@ -60,9 +38,9 @@ def test_circular_shear_keeps_points_on_circles_and_the_normal_stress_difference
     from seadesign.fea.finite_strain import Solid
     from seadesign.fea.hyperelastic import stress
 
-    path, t1, mu = _circular_shear(12, 144, 0.4999, "mean_dilatation")
+    path, t1, mu = circular_shear(12, 144, 0.4999, "mean_dilatation")
     assert path.rotation_at(t1) == pytest.approx(1.0, abs=1e-3)
-    assert _radial_drift(path).max() < 1e-3  # points stay on their circles: < 0.1 % of the arc at 1 rad
+    assert radial_drift(path).max() < 1e-3  # points stay on their circles: < 0.1 % of the arc at 1 rad
     # sigma_tt - sigma_rr = mu gamma^2, gamma = T / (2 pi mu h r^2), averaged over rings of the deformed annulus
     solid = Solid.of(path.emesh, Hyperelastic.from_linear(E, 0.4999), "mean_dilatation")
     u = path.displacement_m

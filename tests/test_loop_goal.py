@@ -22,40 +22,13 @@ says Y" with Y within the tolerance, and the other declared effect unsupported.
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
-from helpers_generators import robot
+from helpers_goal import GOAL, goal_recording
 from seadesign.loop import explain
 from seadesign.loop.sea import robot_declared, robot_loop_data
 
 DRAWS = [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)]
-# case -> (library key, declared name or None, parameter, range, fixed parameters, relative tolerance, length s);
-# tolerances about three times the worst error over the three draws: backlash 0.018, gear friction 0.0075,
-# delay 0.0029, step 0.0034, thermal softening 0.093
-GOAL = {
-    "backlash": ("dead_band", "backlash", "width_rad", (0.02, 0.05), {}, 0.05, 60.0),
-    "gear_friction": ("friction", "gear_friction", "coulomb_Nm", (0.2, 0.5), {"viscous_Nm_s_per_rad": 0.0}, 0.022, 60.0),
-    "sensor_delay": ("sensor_delay", None, "delay_s", (0.02, 0.06), {}, 0.009, 60.0),
-    "sensor_step": ("sensor_step", None, "size_rad", (0.03, 0.15), {}, 0.01, 60.0),
-    "thermal_softening": ("thermal_softening", None, "softening_per_J", (0.012, 0.016), {"cooling_time_s": 300.0},
-                          0.3, 120.0),
-    "none": (None, None, None, None, {}, None, 60.0),
-}
-
-
-def goal_recording(case: str, draw_index: int):
-    key, _, param, bounds, fixed, _, duration = GOAL[case]
-    rng = np.random.default_rng([draw_index, sum(map(ord, case)), 5])
-    effects, value = {}, None
-    if key:
-        value = float(rng.uniform(*bounds))
-        effects = {key: {param: value, **fixed}}
-        if key == "sensor_step":
-            effects[key]["time_s"] = round(float(rng.uniform(0.2, 0.8)) * duration, 2)
-    return robot(effects, seed=40 + draw_index, duration_s=duration), value
-
-
 @pytest.mark.parametrize("draw_index", DRAWS)
 @pytest.mark.parametrize("case", list(GOAL))
 def test_goal_plain_model_names_exactly_the_effect(spring_dict, case, draw_index):
