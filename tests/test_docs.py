@@ -106,3 +106,20 @@ def test_site_builds_strict(tmp_path):
     assert (tmp_path / "site" / "reference" / "cli" / "index.html").read_text().count("seadesign sweep") > 0
     config = (tmp_path / "site" / "reference" / "config" / "index.html").read_text()
     assert "requirements.max_standing_deflection_deg" in config  # the generated table of study keys
+
+
+def test_every_validation_fragment_is_written_by_a_benchmark_and_shown():
+    """The measured tables of the docs come from the benchmark scripts (`--docs`): every fragment a page includes
+    is one a script writes, and every fragment a script writes is included by a page."""
+    fragments = ROOT / "docs" / "validation" / "_fragments"
+    written = set()
+    for script in (ROOT / "benchmarks").glob("*.py"):
+        text = script.read_text()
+        written |= set(re.findall(r'write_fragment\("(\w+)"', text))
+        if "TABLES = {" in text:  # validation.py: one fragment per table it measures
+            written |= set(re.findall(r'"(\w+)": \w+', text.split("TABLES = {", 1)[1].split("}", 1)[0]))
+    included = {m for page in (ROOT / "docs").rglob("*.md")
+                for m in re.findall(r'--8<-- "validation/_fragments/(\w+)\.md"', page.read_text())}
+    assert included <= written, f"fragments no benchmark writes: {sorted(included - written)}"
+    assert written <= included, f"fragments no page shows: {sorted(written - included)}"
+    assert {p.stem for p in fragments.glob("*.md")} == included
