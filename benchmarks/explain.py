@@ -18,8 +18,6 @@ python benchmarks/explain.py [--duration-s 600] [--rate-hz 100] [--kind bench|ro
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import time
 
 from seadesign.loop import LoopData, explain
@@ -27,6 +25,7 @@ from seadesign.loop.changepoint import best_split
 from seadesign.loop.sea import bench_loop_data, robot_declared, robot_loop_data
 from seadesign.twin import BenchProtocol, KneeConfig, Trial, bench_effects, knee_effects, simulate, simulate_bench
 from simulate import SPRING  # the benchmarks' spring.json payload (thesis spring, Wolfgang-OP knee)
+from record import machine
 
 K = SPRING["k_Nm_per_rad"]
 
@@ -52,8 +51,7 @@ def main() -> None:
     ap.add_argument("--rate-hz", type=float, default=100.0, help="sample rate (Hz)")
     ap.add_argument("--kind", choices=["bench", "robot", "both"], default="both")
     args = ap.parse_args()
-    print(f"machine: {platform.machine()} {platform.processor() or ''}, {os.cpu_count()} CPUs visible, "
-          f"python {platform.python_version()}; {args.duration_s:g} s at {args.rate_hz:g} Hz; "
+    print(f"machine: {machine()}; {args.duration_s:g} s at {args.rate_hz:g} Hz; "
           f"load reference (a 1500 x 1500 matrix product, same process): {reference():.3f} s")
     print(f"{'recording':<10} {'samples':>8} {'candidates':>10}  {'effects found':<32} {'held-out RMSE':<26} "
           f"{'wall time (s), goal < 30':>24}")

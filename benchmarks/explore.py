@@ -16,8 +16,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
-import platform
 import tempfile
 from pathlib import Path
 
@@ -27,6 +25,7 @@ from seadesign.explore.study_run import explore_study
 from seadesign.run.cache import Cache
 from seadesign.run.executors import default_jobs
 from seadesign.sweep.stages import SolverSettings
+from record import machine
 
 
 def main() -> None:
@@ -54,9 +53,7 @@ def main() -> None:
         run = explore_study(study, args.out or Path(tmp) / "out", loop, solver=solver, cache=cache, jobs=args.jobs,
                             quiet=True)
     t, screened = run.exploration.evaluated, run.exploration.screened
-    load = os.getloadavg()
-    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores, Python "
-          f"{platform.python_version()}, load average at the end {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f}")
+    print(f"machine (at the end): {machine()}")
     print(f"settings: study {study.name}, mesh {dataclasses.asdict(mesh)}, solver {dataclasses.asdict(solver)}, "
           f"loop {dataclasses.asdict(loop)}")
     print(f"full-path evaluations: {len(t)} of {loop.budget}; screenings: {len(screened)} "

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import shutil
 import sys
 import tempfile
@@ -45,6 +44,7 @@ from seadesign.fea.linsolve import full_from_upper
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from helpers_skfem import neo_hooke_forms, skfem_permutation  # noqa: E402  the tests' independent law
+from record import machine  # noqa: E402
 
 # the path's time split: the methods timed in each part (a method called inside another is not nested here)
 PATH_PARTS = {
@@ -128,8 +128,7 @@ def main() -> None:
         stages[f"FEA {key}" + (" (L2 projection, invariants)" if key == "stress" else "")] = r[f"time_{key}_s"]
     stages["FEA other (load-case numbers)"] = t_fea - sum(r[f"time_{k}_s"] for k in ("setup", "assembly", "factorization", "solve", "stress"))
 
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"load average {os.getloadavg()[0]:.1f}; python {platform.python_version()}")
+    print(f"machine: {machine()}")
     print(f"candidate: {args.beams} beams / {args.thickness_mm:g} mm ({st.name}), material {m.name}")
     print(f"mesh: {args.backend}, coarsening {args.coarsening:g}: {across:g} elements across the beam -> {mesh.info['target_edge_mm']:.3g} mm, "
           f"{per_circle:g} per turn on curved surfaces; "

@@ -8,16 +8,14 @@ the same number of samples.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import time
 from pathlib import Path
 
-import numpy as np
 
 from seadesign import __version__
 from seadesign.design.spring import load_spring
 from seadesign.twin import KneeSession, thesis_protocol
+from record import machine
 
 SPRING = load_spring(Path(__file__).resolve().parents[1] / "studies" / "thesis_measured_spring.json")
 
@@ -28,8 +26,7 @@ def main() -> None:
     parser.add_argument("--rate-hz", type=float, default=100.0, help="sample rate, Hz")
     args = parser.parse_args()
     total_s = args.hours * 3600.0
-    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores, {platform.processor() or '?'}; "
-          f"python {platform.python_version()}, numpy {np.__version__}, seadesign {__version__}")
+    print(f"machine: {machine()}; seadesign {__version__}")
     print(f"settings: {args.hours:g} h at {args.rate_hz:g} Hz, both knees, default effects; ground and hanging")
     print(f"{'layout':32s} {'mode':8s} {'samples/knee':>12s} {'substeps':>8s} {'wall s':>8s} {'x real time':>11s}")
     for trial_s in (10.0, 50.0, 200.0):

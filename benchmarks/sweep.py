@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import resource
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+from record import machine
 
 
 def timed_sweep(study: str, jobs: int, out: Path, cache: Path) -> tuple[float, float]:
@@ -40,7 +40,7 @@ def main() -> None:
         out, cache = Path(d) / "exports", Path(d) / "cache"
         cold = timed_sweep(args.study, args.jobs, out, cache)
         warm = timed_sweep(args.study, args.jobs, out, cache)
-    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}")
+    print(f"machine: {machine()}")
     print(f"settings: study {args.study}, jobs {args.jobs}")
     print(f"{'run':<6} {'wall_s':>8} {'peak_rss_MiB':>13}")
     for name, (wall, rss) in (("cold", cold), ("warm", warm)):

@@ -10,8 +10,6 @@ forward+backward = the rollout with its graph and the backward pass of the mean 
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import time
 from pathlib import Path
 
@@ -21,6 +19,7 @@ from seadesign import __version__
 from seadesign.design.spring import load_spring
 from seadesign.twin import KneeConfig, knee_effects, thesis_protocol
 from seadesign.twin.torch_knee import TorchKnee, protocol_tensors, rollout
+from record import machine
 
 SPRING = load_spring(Path(__file__).resolve().parents[1] / "studies" / "thesis_measured_spring.json")
 
@@ -53,8 +52,7 @@ def main() -> None:
     args = parser.parse_args()
     trials = thesis_protocol(10.0)
     cfg = KneeConfig.from_spring(SPRING)
-    print(f"machine: {platform.node()} {platform.machine()}, {os.cpu_count()} cores, {platform.processor() or '?'}; "
-          f"python {platform.python_version()}, torch {torch.__version__}, seadesign {__version__}")
+    print(f"machine: {machine()}; torch {torch.__version__}, seadesign {__version__}")
     print(f"settings: batch {len(trials)} trials x 2 knees, 100 Hz, ground, default effects, noise on; "
           f"best of {args.repeats}")
     print(f"{'dtype':>8} {'threads':>7} {'window':>6} {'forward steps/s':>16} {'fwd+bwd steps/s':>16}")

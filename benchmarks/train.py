@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import tempfile
 import time
 from pathlib import Path
@@ -29,6 +28,7 @@ from seadesign.corrector.splits import time_block_split
 from seadesign.corrector.synthetic import linear_spring_recording
 from seadesign.corrector.train import TrainConfig, fit
 from seadesign.onnx_corrector import load_onnx
+from record import machine
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "deepsea"
 K = 9.106  # Nm/rad, the thesis's measured spring
@@ -57,8 +57,7 @@ def main() -> None:
     recs = load_recordings(files) if files else [linear_spring_recording(K, 30.0, seed=s, name=f"syn{s}")
                                                  for s in range(3)]
     source = "real: " + ", ".join(f.name for f in files) if files else "synthetic (../shared absent)"
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"torch {torch.__version__}, numpy {np.__version__}, python {platform.python_version()}")
+    print(f"machine: {machine()}; torch {torch.__version__}")
     print(f"data: {source}; task thesis, modalities velocity_effort, positive; split time_blocks; "
           f"training threads {args.threads}, device {'cuda' if torch.cuda.is_available() else 'cpu'}")
     header = (f"{'model':<10} {'samples':>8} {'batch':>6} {'epochs':>7} {'best':>5} {'stop':>10} {'wall_s':>7} "

@@ -13,8 +13,6 @@ NumPy network; and the network alone under ONNX Runtime), median over many calls
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import tempfile
 import time
 
@@ -28,6 +26,7 @@ from seadesign.corrector.runtime import ReferenceFeedForward
 from seadesign.corrector.workflow import train_reference_bundle
 from seadesign.design.spring import load_spring
 from seadesign.onnx_corrector import load_onnx
+from record import machine
 
 
 def _median_us(fn, calls: int) -> float:
@@ -49,8 +48,7 @@ def main() -> None:
     args = ap.parse_args()
     spring = load_spring(args.spring)
     settings = ImitationSettings()
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, load average "
-          f"{os.getloadavg()[0]:.1f}; torch {torch.__version__}, numpy {np.__version__}, python {platform.python_version()}")
+    print(f"machine: {machine()}; torch {torch.__version__}")
     print(f"spring: {args.spring} (k {spring['k_Nm_per_rad']:.4g} Nm/rad, curve: {'torque_curve' in spring}); "
           f"labels: {len(settings.trials())} trials x {settings.trial_s:g} s at {settings.rate_hz:g} Hz, settings "
           f"{', '.join(settings.settings)}, k scales {settings.k_scales}; training threads {settings.train.threads}, "
