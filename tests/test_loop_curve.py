@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from helpers_generators import K, robot
-from seadesign.effects import CurveRangeError
-from seadesign.loop import explain
+from seadesign.loop import LoopInputError, explain
 from seadesign.loop.sea import robot_loop_data
 
 K3 = -80.0  # the generator's spring softens: T = k d + K3 d^3 (monotone up to 0.19 rad)
@@ -46,8 +45,20 @@ def test_curve_is_the_spring_and_explains_the_softening(spring_dict, softening_k
     assert with_curve.final.parameters()["stiffness_scale"]["scale"]["value"] == pytest.approx(1.0, abs=0.02)
 
 
-def test_data_past_the_curve_is_refused_not_extrapolated(spring_dict, softening_knee):
-    with pytest.raises(CurveRangeError, match=r"past the spring's torque curve: the curve ends at 0\.05 rad"):
-        explain(robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.05)}), [])
+def test_data_past_the_curve_are_left_out_not_extrapolated(spring_dict, softening_knee):
+    """A robot recording whose deflection goes past the curve's end: those samples are left out of the fit and
+    counted (never extrapolated), the rest still says the spring is the declared one; a record with fewer than half
+    its samples on the curve is refused, naming the range the curve covers."""
+    data = robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.05)})
+    motor_minus_hall = (softening_knee["l_knee_pos"] - softening_knee["l_hall_pos"]).abs().to_numpy()
+    assert data.coverage is not None and data.coverage.excluded == pytest.approx((motor_minus_hall > 0.05).sum(), rel=0.03)
+    ex = explain(data, [])
+    assert ex.found == [], ex.verdict()
+    scale = ex.final.parameters()["stiffness_scale"]["scale"]
+    assert abs(scale["value"] - 1.0) <= 3 * scale["uncertainty"]  # measured 1.0048 +- 0.0038
+    assert "left out of the fit" in ex.verdict()
+    with pytest.raises(LoopInputError, match=r"only \d+ of 6000 samples \(45%\) lie within the spring's torque curve, "
+                                             r"which covers deflections up to 0\.03 rad"):
+        robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.03)})
     stop = robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.05, hard_stop=True)})
-    assert stop.n == len(softening_knee)  # a hard stop holds the rotation at the end instead
+    assert stop.in_range.all() and stop.coverage is None  # a hard stop holds the rotation at the end instead

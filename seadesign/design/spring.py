@@ -162,12 +162,13 @@ class TorqueCurve:
             lo, hi = (mid, hi) if stored(mid) < energy_J else (lo, mid)
         return float(self._pchip()(0.5 * (lo + hi)))
 
-    def torque(self, rotation_rad: np.ndarray) -> np.ndarray:
-        """T(theta) (Nm), odd in theta; past the end: the end torque with a hard stop, else CurveRangeError."""
+    def torque(self, rotation_rad: np.ndarray, clamp: bool = False) -> np.ndarray:
+        """T(theta) (Nm), odd in theta; past the end: the end torque with a hard stop or `clamp` (a fitter's trial
+        values, samples the fit leaves out), else CurveRangeError."""
         th = np.asarray(rotation_rad, dtype=float)
         a = np.abs(th)
         past = a > self.end_rotation_rad
-        if past.any() and not self.hard_stop:
+        if past.any() and not (self.hard_stop or clamp):
             raise CurveRangeError(f"rotation {float(a.max()):.4g} rad is past the spring's torque curve: {self._end()}")
         return np.sign(th) * self._pchip()(np.minimum(a, self.end_rotation_rad))
 

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from seadesign.design.spring import TorqueCurve
-from seadesign.effects.base import Effect, Param, Scales, Search
+from seadesign.effects.base import Effect, Param
 from seadesign.effects.spring import LinearSpring
 
 
@@ -36,25 +36,23 @@ class SpringCurve(Effect):
     reads = ("deflection",)
     writes = "torque"
 
-    def __init__(self, curve: TorqueCurve, name: str | None = None, **options: Any) -> None:
+    def __init__(self, curve: TorqueCurve, name: str | None = None, clamp: bool = False, **options: Any) -> None:
         self.curve = curve
+        self.clamp = clamp  # past the curve's end: the end torque (the loop's trial values), else CurveRangeError
         super().__init__(name, **options)
 
-    def replace(self, *, enabled: bool | None = None, **values: float) -> "SpringCurve":
-        return SpringCurve(self.curve, self.name, enabled=self.enabled if enabled is None else enabled,
-                           bind=self.bind, **{**self.values, **values})
+    def replace(self, *, enabled: bool | None = None, clamp: bool | None = None, **values: float) -> "SpringCurve":
+        return SpringCurve(self.curve, self.name, self.clamp if clamp is None else clamp,
+                           enabled=self.enabled if enabled is None else enabled, bind=self.bind,
+                           **{**self.values, **values})
 
     def _map(self, x, p, rng):
-        return x["torque"] + p["scale"] * self.curve.torque(x["deflection"])
+        return x["torque"] + p["scale"] * self.curve.torque(x["deflection"], clamp=self.clamp)
 
     def rotation(self, torque_Nm: np.ndarray, scale: float | None = None, clamp: bool = False) -> np.ndarray:
         """Deflection (rad) at which the scaled curve carries `torque_Nm` (`clamp`: see `TorqueCurve.rotation`)."""
         return self.curve.rotation(np.asarray(torque_Nm) / (self.values["scale"] if scale is None else scale),
                                    clamp=clamp)
-
-    def search(self, s: Scales) -> Search:
-        lowest = max(0.01, s.torque_Nm / self.curve.end_torque_Nm) if not self.curve.hard_stop else 0.01
-        return {"scale": (lowest, 100.0)}, [{"scale": max(1.0, lowest)}]
 
     def describe(self) -> dict[str, Any]:
         out = super().describe()

@@ -135,6 +135,8 @@ class Explanation:
                     f"(held-out RMSE {h0:.4g} -> {h1:.4g} {unit}); nothing is named.")
         if self.unsupported:
             text += f" Declared but unsupported by the data: {', '.join(self.unsupported)}."
+        if self.data.coverage is not None:
+            text += " " + self.data.coverage.text()
         if not self.final.converged:
             text += " The final fit did not converge (evaluation limit): its numbers are not a result."
         s = self.tests_after["strongest"]
@@ -152,11 +154,16 @@ def _term(key: str, data: LoopData, current: Fit) -> Term | None:
     if key != "sensor_step":
         return Term(key, LIBRARY[key]())
     taken = [current.values[t.name]["time_s"] for t in current.terms if t.key == "sensor_step"]
-    index = _jump(data, data.measured - current.prediction, taken)
+    index = _jump(data, _residual(data, current), taken)
     if index is None:
         return None
     name = "sensor_step" if not taken else f"sensor_step_{len(taken) + 1}"
     return _step(data, name, index)
+
+
+def _residual(data: LoopData, fit: Fit) -> np.ndarray:
+    """measured - predicted, zero on the samples the model does not cover (past the torque curve's end)."""
+    return np.where(data.in_range, data.measured - fit.prediction, 0.0)
 
 
 def _jump(data: LoopData, residual: np.ndarray, taken: list[float]) -> int | None:
@@ -179,7 +186,7 @@ def _relocated(data: LoopData, held: np.ndarray, current: Fit, term: Term, f: Fi
     taken = [current.values[t.name]["time_s"] for t in current.terms if t.key == "sensor_step"]
     for _ in range(3):
         without = evaluate(data, current.terms, f.values, held)
-        index = _jump(data, data.measured - without.prediction, taken)
+        index = _jump(data, _residual(data, without), taken)
         if index is None:
             return None
         moved = _step(data, term.name, index)
@@ -234,8 +241,8 @@ def explain(data: LoopData, declared: Sequence[Effect] = (), *, exclude: Sequenc
     sig = dict(data.signals)
     return Explanation(
         data=data, held=held, plain=plain, base=base, final=current, steps=steps, last_trace=trace, declared=checks,
-        tests_before=residual_tests(data.measured - plain.prediction, data.time, sig),
-        tests_after=residual_tests(data.measured - current.prediction, data.time, sig),
+        tests_before=residual_tests(_residual(data, plain), data.time, sig),
+        tests_after=residual_tests(_residual(data, current), data.time, sig),
         settings={"min_gain": min_gain, "min_bic_drop": min_bic_drop, "ambiguity": ambiguity, "max_steps": max_steps,
                   "screen": screen, "n_blocks": n_blocks, "held_out_blocks": list(held_out_blocks),
                   "declared": [t.name for t in decl], "excluded": list(exclude), "candidates": pool},

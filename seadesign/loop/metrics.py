@@ -19,6 +19,9 @@ def metrics(measured: np.ndarray, predicted: np.ndarray) -> dict[str, float]:
     }
 
 
-def split_metrics(measured: np.ndarray, predicted: np.ndarray, held: np.ndarray) -> dict[str, dict[str, float]]:
-    """Metrics on the training part (~held) and the held-out part (held)."""
-    return {"train": metrics(measured[~held], predicted[~held]), "held_out": metrics(measured[held], predicted[held])}
+def split_metrics(measured: np.ndarray, predicted: np.ndarray, held: np.ndarray,
+                  used: np.ndarray | None = None) -> dict[str, dict[str, float]]:
+    """Metrics on the training part (~held) and the held-out part (held), of the samples `used` (all when None)."""
+    used = np.ones(measured.size, bool) if used is None else used
+    train, test = ~held & used, held & used
+    return {"train": metrics(measured[train], predicted[train]), "held_out": metrics(measured[test], predicted[test])}

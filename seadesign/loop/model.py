@@ -112,8 +112,7 @@ class EffectModel:
         names, lo, hi, logs, options = [], [], [], [], []
         scales = data.scales()
         for t in self.terms:
-            source = data.spring if t.key == "stiffness_scale" and hasattr(data.spring, "curve") else t.effect
-            bounds, starts = source.search(scales)
+            bounds, starts = t.effect.search(scales)
             if t.declared:  # refitted from the declared values
                 starts = [{**starts[0], **t.effect.values}]
             for p in t.effect.parameters:
@@ -137,7 +136,7 @@ class EffectModel:
         """Fit on the training samples (~held); `warm` gives start values per term (else its start options,
         every combination tried, the lowest training cost kept)."""
         held = np.zeros(data.n, bool) if held is None else held
-        train = ~held
+        train = ~held & data.in_range
         names, lo, hi, logs, options = self._space(data)
         free = lo < hi
         to_u = lambda x: np.where(logs, np.log(np.where(logs, x, 1.0)), x)  # noqa: E731
@@ -202,7 +201,7 @@ class EffectModel:
         for (t, p), a, b in zip(names, lo, hi):
             bounds[t][p] = (float(a), float(b))
         self.fit_ = Fit(list(self.terms), values, self._values(names, sigma), by_term, bounds, pred,
-                        split_metrics(data.measured, pred, held), float(ll + 2 * p_count),
+                        split_metrics(data.measured, pred, held, data.in_range), float(ll + 2 * p_count),
                         float(ll + p_count * np.log(n)), n, converged)
         return self
 
@@ -214,8 +213,8 @@ class EffectModel:
 
     def score(self, data: LoopData, held: np.ndarray | None = None) -> float:
         """RMSE of the fitted model on `data` (on the held-out samples when `held` is given)."""
-        e = data.measured - self.predict(data)
-        return float(np.sqrt(np.mean((e if held is None else e[held]) ** 2)))
+        e = (data.measured - self.predict(data))[data.in_range if held is None else held & data.in_range]
+        return float(np.sqrt(np.mean(e ** 2)))
 
     def parameters(self) -> dict:
         if self.fit_ is None:

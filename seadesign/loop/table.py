@@ -37,8 +37,35 @@ ROLES["velocity"] = "rate of the deflection or position (rad/s or m/s); computed
 DIRECTIONS = ("stiffness", "compliance")
 
 
+#: the least share of a record's samples that must lie on the spring's torque curve
+MIN_IN_RANGE = 0.5
+
+
 class LoopInputError(DataError):
     """The loop's table, columns or roles are unusable (the message names the column and the fix)."""
+
+
+@dataclass(frozen=True)
+class CurveCoverage:
+    """Samples whose measured deflection goes past the end of the spring's torque curve: left out of the fit."""
+
+    excluded: int
+    samples: int
+    end_rotation_rad: float
+    end_torque_Nm: float
+    stop_reason: str  # why the curve ends (the path's stop)
+    max_deflection_rad: float  # the largest measured |deflection|
+    first_time_s: float  # when the measurement first leaves the curve
+
+    def text(self) -> str:
+        """What was left out and what it means."""
+        return (f"{self.excluded} of {self.samples} samples ({self.excluded / self.samples:.1%}) lie past the end of "
+                f"the spring's torque curve and are left out of the fit and its errors: the measured deflection "
+                f"reaches {self.max_deflection_rad:.4g} rad (first at {self.first_time_s:.4g} s), the curve ends at "
+                f"{self.end_rotation_rad:.4g} rad, {self.end_torque_Nm:.4g} Nm (stop reason '{self.stop_reason}'). "
+                "The measurement went where the model does not follow; a part that carries load smoothly past a "
+                "predicted end is evidence against that end (a path that stopped at a bifurcation, an "
+                "unconverged step or a limit point the printed part does not show).")
 
 
 @dataclass
@@ -58,6 +85,8 @@ class LoopData:
     units: dict[str, str] = field(default_factory=dict)
     columns: dict[str, str] = field(default_factory=dict)
     gain: float | None = None
+    in_range: np.ndarray = field(init=False, repr=False)  # samples the model covers (the fit and its errors use these)
+    coverage: "CurveCoverage | None" = field(init=False, default=None)  # where the data leave the torque curve
 
     def __post_init__(self) -> None:
         self.measured = np.asarray(self.measured, dtype=float)
@@ -100,11 +129,36 @@ class LoopData:
             raise LoopInputError("a table needs a predicted column, or a spring and a deflection signal")
         if self.gain is None:
             self.gain = self._gain()
-        if hasattr(self.spring, "curve"):  # the data must lie on the curve (raises past its end, no hard stop)
-            if self.direction == "compliance":
-                self.spring.rotation(self.smooth("torque" if "torque" in self.signals else "effort"))
-            else:
-                self.spring.apply({"deflection": self.signals["deflection"]})
+        self.in_range = np.ones(n, bool)
+        if hasattr(self.spring, "curve"):
+            self._cover(self.spring.curve)
+
+    def _cover(self, curve) -> None:
+        """Leave out the samples whose measured deflection lies past the torque curve's end (nothing is
+        extrapolated), and evaluate the curve clamped for a fitter's trial values; refuse a record of which
+        fewer than `MIN_IN_RANGE` lie on the curve."""
+        if self.direction == "compliance":
+            deflection = self.sign * (self.measured - (0.0 if self.base is None else self.base))
+        else:
+            deflection = self.signals["deflection"]
+        deflection = np.abs(self.smoothed(deflection))
+        self.spring = self.spring.replace(clamp=True)
+        if curve.hard_stop:  # the stop carries the rest: every sample is on the model
+            return
+        self.in_range = deflection <= curve.end_rotation_rad
+        n_in = int(self.in_range.sum())
+        if n_in < MIN_IN_RANGE * self.n:
+            raise LoopInputError(
+                f"only {n_in} of {self.n} samples ({n_in / self.n:.0%}) lie within the spring's torque curve, which "
+                f"covers deflections up to {curve.end_rotation_rad:.4g} rad ({curve.end_torque_Nm:.4g} Nm; it ends "
+                f"with stop reason '{curve.stop_reason}'); the measured deflection reaches {deflection.max():.4g} "
+                f"rad. The loop needs at least {MIN_IN_RANGE:.0%} of the record on the model: compute the curve "
+                "further, or test over the range it covers")
+        if n_in < self.n:
+            out = ~self.in_range
+            self.coverage = CurveCoverage(int(out.sum()), self.n, curve.end_rotation_rad, curve.end_torque_Nm,
+                                          curve.stop_reason, float(deflection[out].max()),
+                                          float(self.time[np.flatnonzero(out)[0]]))
 
     def _gain(self) -> float:
         """Slope of the spring path against the deflection (measured unit per deflection unit)."""
