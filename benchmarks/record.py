@@ -38,12 +38,14 @@ def machine() -> str:
 
 
 def commit() -> str:
-    """The checkout's short commit, "+ changes" when the tree differs from it."""
+    """The checkout's short commit, "+ changes" when the tree differs from it (the fragments aside: a run that
+    writes several changes them itself)."""
     def git(*args: str) -> str:
         return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
 
     head = git("rev-parse", "--short", "HEAD") or "unknown"
-    return head + (" + changes" if git("status", "--porcelain", "--untracked-files=no") else "")
+    changed = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!docs/validation/_fragments")
+    return head + (" + changes" if changed else "")
 
 
 def add_docs_option(parser: argparse.ArgumentParser, *fragments: str) -> None:

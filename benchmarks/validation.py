@@ -3,7 +3,8 @@ shear, CalculiX NLGEOM against the path, the calibration loop's goal, and the lo
 Each table's test asserts its numbers within a tolerance; this script writes the numbers themselves.
 
 Usage: python benchmarks/validation.py TABLE [TABLE ...] [--draws 3] [--docs]
-TABLE: circular_shear (about 2 min), ccx_path (CalculiX `ccx` on PATH; about 10 min), loop_goal (3 draws:
+TABLE: circular_shear (about 1 min), ccx_path (CalculiX `ccx` on PATH; about 7 min, `--default-mesh` about 10 min
+more), loop_goal (3 draws:
 about 15 min), loop_real (needs ../shared/data/deepsea; about 10 min). `--docs` writes
 docs/validation/_fragments/TABLE.md.
 """
@@ -56,6 +57,12 @@ def ccx_path(args) -> tuple[Table, str]:
             return tetrahedralize(study, checked, part, Cache(), coarsening=4.0)
         cases.append((f"{beams} beams x {thickness_mm:g} mm, mesh 4x coarser", mesh, study.material.law,
                       study.load_cases.stall_torque_Nm, PathSettings(max_rotation_rad=0.4, max_step_rad=step)))
+    if args.default_mesh:  # the smallest of the default study's result meshes, to 0.1 rad
+        def default_mesh():
+            checked, part = study.check(study.candidate(beam_count=3, beam_thickness_mm=6.0))
+            return tetrahedralize(study, checked, part, Cache())
+        cases.append(("3 beams x 6 mm, the study's default mesh", default_mesh, study.material.law,
+                      study.load_cases.stall_torque_Nm, PathSettings(max_rotation_rad=0.1)))
     work = Path(args.work)
     for name, make_mesh, law, target, settings in cases:
         mesh = make_mesh()
@@ -151,6 +158,8 @@ def main() -> None:
     ap.add_argument("tables", nargs="+", choices=list(TABLES))
     ap.add_argument("--draws", type=int, default=3, help="loop_goal: seeded draws per case")
     ap.add_argument("--work", default="exports/validation", help="ccx_path: CalculiX's working folder")
+    ap.add_argument("--default-mesh", action="store_true",
+                    help="ccx_path: also 3 beams x 6 mm on the study's default mesh (about 10 min more)")
     ap.add_argument("--docs", action="store_true", help="write docs/validation/_fragments/TABLE.md")
     args = ap.parse_args()
     Path(args.work).mkdir(parents=True, exist_ok=True)

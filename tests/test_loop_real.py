@@ -29,7 +29,7 @@ ROWS = {
     ("free_dtest_part1", "r"): (["stiffness_scale", "sensor_delay", "hysteresis", "sensor_offset"], ["backlash"],
                                 0.1601, 0.06850),
     ("ground_dtest_part1", "l"): (["stiffness_scale", "sensor_offset", "sensor_step", "sensor_step_2", "sensor_delay"],
-                                  ["backlash", "gear_friction"], 1.483, 0.1044),
+                                  ["backlash", "gear_friction"], 1.483, 0.1038),
     ("ground_dtest_part1", "r"): (["stiffness_scale", "sensor_offset", "hysteresis"], ["backlash", "gear_friction"],
                                   1.093, 0.1622),
     ("d1free", "l"): (["stiffness_scale"], ["backlash", "gear_friction"], 0.01644, 0.005232),
