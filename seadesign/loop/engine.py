@@ -30,7 +30,7 @@ from typing import Sequence
 
 import numpy as np
 
-from seadesign.effects import LIBRARY, Effect, SensorStep, StiffnessScale
+from seadesign.effects import Effect, SensorStep, StiffnessScale
 from seadesign.loop.changepoint import best_split
 from seadesign.loop.model import EffectModel, Fit, evaluate
 from seadesign.loop.table import LoopData, LoopInputError, time_blocks
@@ -133,6 +133,12 @@ class Explanation:
         else:
             text = (f"No effect gives a significant held-out improvement over the declared model "
                     f"(held-out RMSE {h0:.4g} -> {h1:.4g} {unit}); nothing is named.")
+        for t in self.final.terms:
+            if t.on_torque:
+                value = self.final.values[t.name]
+                lag = (f"delayed by {value['delay_s'] * 1e3:.3g} ms" if "delay_s" in value else
+                       f"low-pass filtered with a time constant of {value['time_constant_s'] * 1e3:.3g} ms")
+                text += f" The torque reading lags the deflection reading: {lag} ({t.name})."
         if self.unsupported:
             text += f" Declared but unsupported by the data: {', '.join(self.unsupported)}."
         if self.data.coverage is not None:
@@ -152,7 +158,7 @@ class Explanation:
 def _term(key: str, data: LoopData, current: Fit) -> Term | None:
     """A fresh candidate term for `key` (a sensor step at the instant the current residual jumps)."""
     if key != "sensor_step":
-        return Term(key, LIBRARY[key]())
+        return Term.of(key)
     taken = [current.values[t.name]["time_s"] for t in current.terms if t.key == "sensor_step"]
     index = _jump(data, _residual(data, current), taken)
     if index is None:
@@ -255,7 +261,7 @@ def _trace(data: LoopData, held: np.ndarray, current: Fit, pool: list[str], gate
     held_values = {t.name: current.values[t.name] for t in current.terms if t.declared and t.key != SCALE}
     screened = []
     for key in pool:
-        if key in {t.key for t in current.terms} and key != "sensor_step":
+        if key in {t.candidate for t in current.terms} and key != "sensor_step":
             continue
         term = _term(key, data, current)
         if term is None:

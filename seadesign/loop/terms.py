@@ -12,7 +12,12 @@ effect's, with the effect's names and units. `PLACES` says where an effect acts:
   hysteresis, viscoelasticity (torque terms; in the compliance direction inverted: a Newton solve of
   the cubic, the inverse of the standard-linear-solid filter, the Dahl loop sharing the torque with k), thermal and
   temperature softening (factors; thermal in the compliance direction marched in time);
-- `load` (stiffness direction): friction against `velocity`, gravity against `angle`.
+- `load` (stiffness direction): friction against `velocity`, gravity against `angle`;
+- `torque_channel` (a bench in the stiffness direction): the torque sensor's channel lags the deflection's,
+  a pure delay (`torque_delay`: `SensorDelay` on the torque, the torque behind the deflection; the deflection
+  behind the torque is the deflection reading's `sensor_delay`) or a first-order low-pass such as a filtered
+  load-cell amplifier (`torque_lag`: `EffortLag`'s filter on the torque). The same library effects as on
+  their default channels (`TORQUE_CHANNEL`), applied to the predicted torque.
 
 A spring model (bench, robot) reads its input (deflection; torque or effort, with the friction taken off
 it) through the zero-phase Savitzky-Golay smoother (`LoopData.smooth`, ~0.1 s): the input's noise would
@@ -30,6 +35,7 @@ import numpy as np
 from scipy.ndimage import shift
 
 from seadesign.effects import LIBRARY, Effect
+from seadesign.effects.base import lowpass
 from seadesign.effects.spring import dahl, dahl_in_series, sls_deflection, softening_marched, solve_cubic
 from seadesign.loop.table import LoopData
 
@@ -43,8 +49,11 @@ PLACES: dict[str, str] = {
 ORDER = ("effort_lag", "friction", "dead_band", "stiffness_scale", "cubic_stiffening", "hysteresis", "viscoelastic",
          "thermal_softening", "temperature_softening", "gravity", "sensor_delay", "sensor_offset", "sensor_step",
          "sensor_drift")
-#: effects the loop can trace as candidates (library keys); the spring itself is declared, not traced
-CANDIDATES = tuple(k for k in ORDER if k != "stiffness_scale")
+#: loop candidates that are a library effect on a bench's torque channel: name -> (library key, binding)
+TORQUE_CHANNEL = {"torque_delay": ("sensor_delay", {"hall": "torque"}), "torque_lag": ("effort_lag", {"effort": "torque"})}
+#: effects the loop can trace as candidates (library keys, and the torque-channel names); the spring itself is
+#: declared, not traced
+CANDIDATES = tuple(k for k in ORDER if k != "stiffness_scale") + tuple(TORQUE_CHANNEL)
 #: effects whose value at a sample needs the whole record (history or neighbours: the smoothed friction, the
 #: sensor effects undone before smoothing); a model without them is evaluated on the fitted rows alone
 WHOLE_RECORD = frozenset({"hysteresis", "viscoelastic", "thermal_softening", "sensor_delay"})
@@ -53,7 +62,7 @@ WHOLE_RECORD = frozenset({"hysteresis", "viscoelastic", "thermal_softening", "se
 def whole_record(terms: list[Term], data: LoopData) -> bool:
     """Whether `terms` on `data` need the whole record (else the fitted rows alone will do)."""
     keys = {t.key for t in terms}
-    return bool(keys & WHOLE_RECORD) or (data.direction == "compliance" and "friction" in keys) or \
+    return bool(keys & WHOLE_RECORD) or any(t.on_torque for t in terms) or (data.direction == "compliance" and "friction" in keys) or \
         (data.sensor_on == "deflection" and data.spring is not None and bool(keys & {k for k, v in PLACES.items()
                                                                                       if v == "sensor"}))
 
@@ -66,15 +75,31 @@ class Term:
     name: str
     effect: Effect
     declared: bool = False
+    on_torque: bool = False  # a sensor effect of the bench's torque channel (`TORQUE_CHANNEL`)
 
     @property
     def key(self) -> str:
         return self.effect.key
 
+    @property
+    def candidate(self) -> str:
+        """The loop candidate this term is: its library key, or its torque-channel name."""
+        return self.name if self.on_torque else self.key
+
+    @classmethod
+    def of(cls, candidate: str) -> "Term":
+        """A fresh term of a loop candidate (`CANDIDATES`) at its library defaults."""
+        if candidate in TORQUE_CHANNEL:
+            key, bind = TORQUE_CHANNEL[candidate]
+            return cls(candidate, LIBRARY[key](candidate, bind=bind), on_torque=True)
+        return cls(candidate, LIBRARY[candidate]())
+
 
 def place(term: Term, data: LoopData) -> str:
     """Where `term` acts on `data`: in the compliance direction friction is taken off the torque input (gear
     friction off the effort, against the motor velocity; a bench's friction against the deflection rate)."""
+    if term.on_torque:
+        return "torque_channel"
     if term.key == "friction" and data.direction == "compliance":
         return "effort"
     return PLACES[term.key]
@@ -89,6 +114,7 @@ def applicable(key: str, data: LoopData) -> bool:
         "gravity": not comp and "angle" in s,
         "temperature_softening": "temperature" in s,
         "stiffness_scale": data.spring is not None or np.ptp(data.predicted) > 0,
+        **dict.fromkeys(TORQUE_CHANNEL, not comp and data.sensor_on == "deflection" and data.spring is not None),
     }
     spring_terms = ("dead_band", "cubic_stiffening", "hysteresis", "viscoelastic", "thermal_softening")
     if key in spring_terms:
@@ -103,11 +129,16 @@ def ordered(terms: list[Term]) -> list[Term]:
 def predict(data: LoopData, terms: list[Term], values: dict[str, dict[str, float]]) -> np.ndarray:
     """The model's prediction of `data.measured` with `terms` at `values` (term name -> parameter -> value)."""
     terms = ordered(terms)
-    at = {p: [t for t in terms if place(t, data) == p] for p in ("sensor", "effort", "deflection", "spring", "load")}
+    at = {p: [t for t in terms if place(t, data) == p]
+          for p in ("sensor", "effort", "deflection", "spring", "load", "torque_channel")}
     if data.direction == "compliance":
         y = (0.0 if data.base is None else data.base) + data.sign * _deflection(data, at, values)
     else:
         y = _torque(data, at, values)
+        for t in at["torque_channel"]:  # the torque sensor's channel behind the deflection's
+            p = values[t.name]
+            y = shift(y, p["delay_s"] / data.dt, order=3, mode="nearest") if t.key == "sensor_delay" else \
+                lowpass(y, data.time, p["time_constant_s"])
     if data.sensor_on == "measured":
         for t in at["sensor"]:
             y = _delayed(data, y, values[t.name]["delay_s"]) if t.key == "sensor_delay" else \

@@ -145,7 +145,8 @@ def knee_effects(cfg: KneeConfig, ground: bool = False) -> EffectChain:
 
 def bench_effects(k_Nm_per_rad: float, curve: TorqueCurve | None = None) -> EffectChain:
     """The bench simulator's chain: spring on (`curve` when given, else k); dead-band, torque-path effects,
-    friction, sensor effects declared and off except torque and deflection noise."""
+    friction, sensor effects declared and off except torque and deflection noise; the torque channel's delay and
+    low-pass (a filtered load-cell amplifier) off."""
     return EffectChain([
         DeadBand("dead_band", enabled=False),
         spring_law(k_Nm_per_rad, curve),
@@ -161,6 +162,8 @@ def bench_effects(k_Nm_per_rad: float, curve: TorqueCurve | None = None) -> Effe
         SensorDrift("hall_drift", enabled=False),
         SensorNoise("hall_noise", std_rad=0.001),
         Quantisation("hall_quantisation", enabled=False, bits=12),
+        SensorDelay("torque_delay", enabled=False, bind={"hall": "torque_sensor"}),
+        EffortLag("torque_lag", enabled=False, bind={"effort": "torque_sensor"}),
         SensorNoise("torque_noise", bind={"hall": "torque_sensor"}, std_rad=0.02),
     ])
 
