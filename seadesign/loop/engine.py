@@ -79,6 +79,8 @@ class DeclaredCheck:
 
     def text(self) -> str:
         parts = [f"{p} declared {self.declared[p]:.4g}, data says {v['value']:.4g} +- {v['uncertainty']:.2g} {v['unit']}"
+                 + "".join(f" (correlated with {other}, r = {r:+.2f}: they trade off; the uncertainty covers it)"
+                           for other, r in v.get("correlated_with", {}).items())
                  for p, v in self.fitted.items() if not v["held"]]
         if self.key == SCALE:
             verdict = "differs from the declared k" if self.supported else "consistent with the declared k"

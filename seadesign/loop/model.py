@@ -35,6 +35,8 @@ from seadesign.loop.terms import Term, predict, whole_record
 
 MAX_FIT_ROWS = 8000
 HAC_LAGS = 2
+#: |correlation| of two parameters' estimates from which the report names them as trading off
+CORRELATED = 0.5
 
 
 def _hac(g: np.ndarray, lags: int) -> np.ndarray:
@@ -64,14 +66,18 @@ class Fit:
     n_train: int
     converged: bool = True
     extra: dict = field(default_factory=dict)
+    correlation: dict[tuple[str, str], dict[tuple[str, str], float]] = field(default_factory=dict)
+    # (term, parameter) -> the other fitted parameters it is correlated with at |r| >= CORRELATED, and r
 
     @property
     def keys(self) -> tuple[str, ...]:
         return tuple(t.name for t in self.terms)
 
     def parameters(self) -> dict[str, dict[str, dict[str, float | str | bool]]]:
-        """term -> parameter -> {value, uncertainty, unit, meaning, at_bound} (at_bound: the fit hit a search
-        bound, so the value is a limit, not an estimate; a held parameter is never at a bound)."""
+        """term -> parameter -> {value, uncertainty, unit, meaning, at_bound, held, correlated_with} (at_bound: the
+        fit hit a search bound, so the value is a limit, not an estimate; a held parameter is never at a bound;
+        correlated_with: "term.parameter" -> correlation r of the estimates, for |r| >= `CORRELATED`: the two trade
+        off in the fit, and the uncertainty is the marginal one, which covers that trade-off)."""
         out: dict = {}
         for t in self.terms:
             docs = {p.name: p.doc for p in t.effect.parameters}
@@ -80,7 +86,8 @@ class Fit:
                 at_bound = lo < hi and bool(np.isclose(v, lo, rtol=1e-6, atol=0) or np.isclose(v, hi, rtol=1e-6, atol=0))
                 out.setdefault(t.name, {})[name] = {
                     "value": float(v), "uncertainty": float(self.sigma[t.name][name]), "unit": self.units[t.name][name],
-                    "meaning": docs[name], "at_bound": at_bound, "held": lo == hi}
+                    "meaning": docs[name], "at_bound": at_bound, "held": lo == hi,
+                    "correlated_with": {f"{a}.{b}": r for (a, b), r in self.correlation.get((t.name, name), {}).items()}}
         return out
 
     def term(self, name: str) -> Term:
@@ -94,6 +101,18 @@ def display_unit(p: Param, data: LoopData) -> str:
         return p.unit
     measured, deflection = data.measured_unit, data.unit("deflection")
     return p.unit.replace("Nm", "\0").replace("rad", deflection).replace("\0", measured)
+
+
+def _correlated(cov: np.ndarray, names: list[tuple[str, str]]) -> dict:
+    """(term, parameter) -> {other: r} for the pairs of estimates correlated at |r| >= CORRELATED."""
+    sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = cov / np.outer(sd, sd)
+    out: dict = {}
+    for i, j in zip(*np.nonzero(np.abs(np.nan_to_num(r)) >= CORRELATED)):
+        if i != j:
+            out.setdefault(names[i], {})[names[j]] = float(r[i, j])
+    return out
 
 
 class EffectModel:
@@ -180,6 +199,7 @@ class EffectModel:
         pred = predict(data, self.terms, values)
         ssr = float(np.sum((data.measured[train] - pred[train]) ** 2))
         sigma = np.zeros(len(names))
+        correlation: dict = {}
         if best is not None:
             with np.errstate(over="ignore", divide="ignore"):
                 jac = best.jac * np.where(logs[free], 1.0 / x_best[free], 1.0)  # d/dx = d/du / x for log parameters
@@ -189,6 +209,7 @@ class EffectModel:
                 meat = _hac(jac * (data.measured[rows] - pred[rows])[:, None], -(-data.window // spacing))
                 cov = bread @ meat @ bread * (rows.size / max(n - int(free.sum()), 1))
                 sigma[free] = np.sqrt(np.clip(np.diag(cov), 0, None))
+                correlation = _correlated(cov, [n for n, f in zip(names, free) if f])
             except np.linalg.LinAlgError:
                 sigma[free] = np.nan
         held_dt = [(t, p) for (t, p), f in zip(names, free) if not f and p == "time_s"]
@@ -202,7 +223,7 @@ class EffectModel:
             bounds[t][p] = (float(a), float(b))
         self.fit_ = Fit(list(self.terms), values, self._values(names, sigma), by_term, bounds, pred,
                         split_metrics(data.measured, pred, held, data.in_range), float(ll + 2 * p_count),
-                        float(ll + p_count * np.log(n)), n, converged)
+                        float(ll + p_count * np.log(n)), n, converged, correlation=correlation)
         return self
 
     def predict(self, data: LoopData) -> np.ndarray:
