@@ -68,7 +68,6 @@ class Hyperelastic:
 
     @property
     def shear_modulus_Pa(self) -> float:
-        """Small-strain shear modulus E / (2 (1 + nu)) (Pa)."""
         """The initial shear modulus mu = 2 (C10 + C01) (Pa)."""
         return 2.0 * (self.c10_Pa + self.c01_Pa)
 
