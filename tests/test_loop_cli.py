@@ -35,6 +35,20 @@ def test_explain_bench_file_writes_report_json_and_calibration(tmp_path, spring_
     cal = json.loads((tmp_path / "out" / "bench_calibration.json").read_text())
     assert cal["stiffness_scale"] == pytest.approx(0.75, rel=2e-4)
     assert cal["k_fitted_Nm_per_rad"] == pytest.approx(0.75 * 9.106, rel=2e-4)
+    # the fitted law of the spring's material: every modulus times the scale (the spring was computed at the
+    # material file's modulus), mu = 2 (C10 + C01), the bench file's hash
+    import hashlib
+
+    from seadesign.design.materials import load_material
+
+    law, ninjaflex = cal["law"], load_material("ninjaflex").law
+    assert cal["material"] == "ninjaflex" and law["model"] == ninjaflex.model
+    assert law["c10_Pa"] == pytest.approx(cal["stiffness_scale"] * ninjaflex.c10_Pa, rel=1e-12)
+    assert law["d1_per_Pa"] == pytest.approx(ninjaflex.d1_per_Pa / cal["stiffness_scale"], rel=1e-12)
+    assert law["mu_Pa"] == pytest.approx(2 * (law["c10_Pa"] + law.get("c01_Pa", 0.0)), rel=1e-12)
+    assert law["mu_uncertainty_Pa"] / law["mu_Pa"] == pytest.approx(p["uncertainty"] / p["value"], rel=1e-9)
+    assert "anisotropic" in law["note"]
+    assert cal["source_sha256"] == hashlib.sha256(bench.read_bytes()).hexdigest()
     html = (tmp_path / "out" / "bench.html").read_text()
     assert "data:image/png;base64," in html and (tmp_path / "out" / "bench_loop.png").exists()
 

@@ -210,6 +210,36 @@ def test_calibration_scales_the_modulus(tmp_path):
         apply_calibration(s, tmp_path / "none.json")
 
 
+def test_a_calibrated_law_replaces_only_its_material(tmp_path):
+    """A calibration naming its material and law changes that material alone, in a study with a material axis:
+    every modulus of its law and its Young's modulus by mu_fitted / mu; the other material is untouched."""
+    from seadesign.errors import ConfigError
+    from seadesign.sweep.pipeline import apply_calibration
+
+    study = load_study("wolfgang_knee_explore")
+    ninjaflex, cheetah = study.materials["ninjaflex"], study.materials["cheetah"]
+    mu = 0.4 * ninjaflex.law.shear_modulus_Pa
+    (tmp_path / "c.json").write_text(json.dumps({"material": "ninjaflex", "law": {"model": ninjaflex.law.model,
+                                                                                  "mu_Pa": mu}}))
+    calibrated, note = apply_calibration(study, tmp_path / "c.json")
+    law = calibrated.materials["ninjaflex"].law
+    assert law.shear_modulus_Pa == pytest.approx(mu, rel=1e-12)
+    assert law.d1_per_Pa == pytest.approx(ninjaflex.law.d1_per_Pa / 0.4, rel=1e-12)
+    assert calibrated.materials["ninjaflex"].youngs_modulus_Pa == pytest.approx(0.4 * ninjaflex.youngs_modulus_Pa)
+    assert calibrated.materials["cheetah"] == cheetah and "'ninjaflex'" in note
+    (tmp_path / "other.json").write_text(json.dumps({"material": "generic_tpu", "law": {"model": "neo_hooke",
+                                                                                        "mu_Pa": 1e6}}))
+    with pytest.raises(ConfigError, match="fitted to material 'generic_tpu', which study 'wolfgang_knee_explore' "
+                                          "does not use \\(its materials: ninjaflex, cheetah\\)"):
+        apply_calibration(study, tmp_path / "other.json")
+    (tmp_path / "model.json").write_text(json.dumps({"material": "ninjaflex", "law": {"model": "yeoh", "mu_Pa": 1e6}}))
+    with pytest.raises(ConfigError, match="law/model 'yeoh' was fitted"):
+        apply_calibration(study, tmp_path / "model.json")
+    (tmp_path / "old.json").write_text(json.dumps({"youngs_modulus_Pa": 6e6}))
+    with pytest.raises(ConfigError, match="does not name the material it was fitted to"):
+        apply_calibration(study, tmp_path / "old.json")
+
+
 def test_calibrated_sweep_reranks_and_judges_the_standing_load(tiny, tmp_path):
     """A softer calibrated material: k scales exactly with E (linear elasticity), and so do the torques of the
     large-deflection curve at equal rotations (the hyperelastic law is E times a fixed function of the strain,

@@ -22,6 +22,8 @@ from typing import Any
 import pandas as pd
 
 from seadesign.data import knee_channels
+from seadesign.design.materials import Material, load_material
+from seadesign.errors import ConfigError
 from seadesign.design.spring import torque_curve
 from seadesign.effects import DeadBand, Effect, Friction, spring_law
 from seadesign.loop.engine import Explanation
@@ -83,18 +85,53 @@ def robot_loop_data(df: pd.DataFrame, spring: dict[str, Any], knee: str = "l") -
                  **{r: ch.columns[r] for r in ("motor", "motor_velocity", "effort")}})
 
 
-def calibration(ex: Explanation, spring: dict[str, Any], source: str) -> dict[str, Any]:
+#: what the fitted law is, said with every calibration
+LAW_NOTE = ("an effective isotropic law of a printed part, which is anisotropic (layers, infill): one factor on "
+            "every modulus of the material's law, fitted to the spring's torque against its rotation")
+
+
+def fitted_law(material: Material, spring_modulus_Pa: float, scale: float, scale_uncertainty: float) -> dict[str, Any]:
+    """The material's finite-strain law with every modulus (and 1 / compressibility) times the fitted stiffness
+    scale, relative to the modulus the spring was computed with: parameters (Pa, 1/Pa) with uncertainties and
+    the initial shear modulus mu = 2 (C10 + C01). Exact for a torque curve: a hyperelastic law's stresses scale
+    with its moduli when its compressibilities scale inversely, so the path's torque scales and its shape stays."""
+    factor = spring_modulus_Pa * scale / material.youngs_modulus_Pa
+    law = material.law
+    relative = scale_uncertainty / scale
+    out: dict[str, Any] = {"model": law.model, "factor_on_material_file": factor}
+    for name in ("c10_Pa", "c01_Pa", "c20_Pa", "c30_Pa"):
+        if getattr(law, name):
+            value = getattr(law, name) * factor
+            out[name], out[name.replace("_Pa", "_uncertainty_Pa")] = value, value * relative
+    for name in ("d1_per_Pa", "d2_per_Pa", "d3_per_Pa"):
+        if getattr(law, name):
+            out[name] = getattr(law, name) / factor
+    out["mu_Pa"] = law.shear_modulus_Pa * factor
+    out["mu_uncertainty_Pa"] = out["mu_Pa"] * relative
+    out["youngs_modulus_Pa"] = material.youngs_modulus_Pa * factor  # the linear solve's, following mu
+    out["fitted"] = ["one factor on every modulus (the curve's scale)"]
+    out["note"] = LAW_NOTE
+    return out
+
+
+def calibration(ex: Explanation, spring: dict[str, Any], source: str, source_sha256: str = "",
+                material: Material | None = None) -> dict[str, Any]:
     """The calibration JSON for `seadesign sweep --calibration`: `stiffness_scale` (fitted k / model k; the
-    fitted value whether or not it differs significantly) plus every fitted parameter with unit and uncertainty."""
+    fitted value whether or not it differs significantly), the material calibrated and its fitted law
+    (`fitted_law`: the spring's material, found by its name, unless `material` is given: the fitted modulus
+    expressed as that material's law), the measured file's SHA-256, and every fitted parameter with unit and
+    uncertainty."""
     params = ex.final.parameters()
     k = float(spring["k_Nm_per_rad"])
     scale = params.get("stiffness_scale", {}).get("scale", {"value": 1.0, "uncertainty": 0.0})
     out: dict[str, Any] = {
         "stiffness_scale": scale["value"],
         "stiffness_scale_uncertainty": scale["uncertainty"],
+        "stiffness_scale_correlated_with": scale.get("correlated_with", {}),
         "k_model_Nm_per_rad": k,
         "k_fitted_Nm_per_rad": k * scale["value"],
         "source": source,
+        "source_sha256": source_sha256,
         "effects_found": ex.found,
         "declared": [{"name": c.name, "effect": c.key, "declared": c.declared, "supported": c.supported,
                       "fitted": c.fitted} for c in ex.declared],
@@ -103,9 +140,19 @@ def calibration(ex: Explanation, spring: dict[str, Any], source: str) -> dict[st
         "held_out_rmse_after": ex.final.errors["held_out"]["rmse"],
         "rmse_unit": ex.data.measured_unit,
     }
-    material = spring.get("material") or {}
-    if "youngs_modulus_Pa" in material:
-        out["youngs_modulus_model_Pa"] = material["youngs_modulus_Pa"]
-        out["youngs_modulus_fitted_Pa"] = material["youngs_modulus_Pa"] * scale["value"]
+    modelled = spring.get("material") or {}
+    if "youngs_modulus_Pa" in modelled:
+        out["youngs_modulus_model_Pa"] = modelled["youngs_modulus_Pa"]
+        out["youngs_modulus_fitted_Pa"] = modelled["youngs_modulus_Pa"] * scale["value"]
+        found = material
+        if found is None:
+            try:
+                found = load_material(spring["material"]["name"])
+            except (ConfigError, KeyError):  # a material not on this machine: the modulus alone
+                found = None
+        if found is not None:
+            out["material"] = found.key
+            out["law"] = fitted_law(found, float(spring["material"]["youngs_modulus_Pa"]), scale["value"],
+                                    scale["uncertainty"])
     return out
 

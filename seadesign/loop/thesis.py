@@ -9,6 +9,7 @@ with the FEA's k: it must find the stiffness scale (9.106 / 464 ~ 0.0196) and th
 
 from __future__ import annotations
 
+import hashlib
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +45,10 @@ def worked_example(spring: dict[str, Any], out_dir: Path, seed: int = 0) -> tupl
     write_bench(table, out_dir / "thesis_bench.csv", meta)
     fea = thesis_spring(spring)
     ex = explain(bench_loop_data(table, fea))
-    cal = calibration(ex, fea, str(out_dir / "thesis_bench.csv"))
+    bench = out_dir / "thesis_bench.csv"
+    # the printed part's fitted modulus, expressed as the law of the given spring's material
+    cal = calibration(ex, fea, str(bench), hashlib.sha256(bench.read_bytes()).hexdigest(),
+                      material=load_material(spring["material"]["name"]))
     write_report(ex, out_dir, "thesis", "Thesis case: FEA spring (generic TPU) vs bench with measured k and a dead-band",
                  loop_plot=True, calibration=cal)
     return ex, cal

@@ -29,52 +29,82 @@ CALIBRATION_KEYS = ("youngs_modulus_fitted_Pa", "youngs_modulus_Pa", "stiffness_
 
 
 def apply_calibration(study: Study, path: str | Path) -> tuple[Study, str]:
-    """The study with its Young's modulus from a calibration JSON.
+    """The study with a material calibrated from a calibration JSON.
 
-    The first key found of ``youngs_modulus_fitted_Pa`` (written by `explain`: the model material's E times
-    the fitted stiffness scale) or ``youngs_modulus_Pa`` replaces E (Pa); a bare ``stiffness_scale``
-    multiplies the study's E (right only when it was fitted against this study's material).
+    A file with ``material`` and ``law`` (written by `explain --spring` when the spring's material file is
+    found) replaces that material only, in any study, a material axis included: every modulus of its law, and
+    its Young's modulus with them, times mu_fitted / mu (mu = 2 (C10 + C01)), so the linear solve and every path
+    follow the fitted law. An older file without them gives Young's modulus (``youngs_modulus_fitted_Pa`` or
+    ``youngs_modulus_Pa``, Pa) or a bare ``stiffness_scale`` (a factor, right only when it was fitted against
+    this study's material) for a study with one material.
 
     Parameters
     ----------
     study : Study
-        A study with one material (not a material axis).
+        The study to calibrate.
     path : str or Path
         The calibration JSON, e.g. ``exports/explain/<file>/<file>_calibration.json``.
 
     Returns
     -------
     tuple of (Study, str)
-        The calibrated study, and a one-line note of the new modulus (Pa) and where it came from.
+        The calibrated study, and a one-line note naming the material, its new mu or E (Pa) and the file.
 
     Raises
     ------
     ConfigError
-        The file is not JSON, has none of the keys, its value is not a positive number, or the study's
-        material is a design axis.
+        The file is not JSON or lacks the keys, a value is not a positive number, the law's model differs from
+        the material's, the study does not use the calibrated material, or (an older file) the study's material
+        is a design axis.
 
     Examples
     --------
     >>> import seadesign as sd
     >>> calibrated, note = sd.apply_calibration(sd.load_study(), "thesis_calibration.json")
     """
+    path = Path(path)
     try:
-        data = json.loads(Path(path).read_text())
+        data = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as exc:
         raise ConfigError(f"--calibration {path}: cannot be read as JSON ({exc})") from None
+    if isinstance(data, dict) and "law" in data and "material" in data:
+        return _calibrated_law(study, path, data)
     key = next((k for k in CALIBRATION_KEYS if isinstance(data, dict) and k in data), None)
     if key is None:
-        raise ConfigError(f"--calibration {path}: needs one of {', '.join(CALIBRATION_KEYS)} "
+        raise ConfigError(f"--calibration {path}: needs 'material' and 'law', or one of {', '.join(CALIBRATION_KEYS)} "
                           "(moduli in Pa, the scale a factor on E); `seadesign explain --spring` writes such a file")
-    value = data[key]
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not value > 0:
-        raise ConfigError(f"--calibration {path}: '{key}' must be a positive number, got {value!r}")
+    value = _positive(path, key, data[key])
     if len(study.materials) != 1:
-        raise ConfigError(f"--calibration {path}: study '{study.name}' has the material as a design axis; a "
-                          "calibration is fitted to one material: fix the material in the study to calibrate it")
+        raise ConfigError(f"--calibration {path}: study '{study.name}' has the material as a design axis and the "
+                          "file does not name the material it was fitted to; rerun `seadesign explain --spring` to "
+                          "write one that does, or fix the material in the study")
     (name, material), = study.materials.items()
     scale = value if key == "stiffness_scale" else value / material.youngs_modulus_Pa
-    note = f"calibrated from {Path(path).name} ({key} = {value:.4g}): E = {material.youngs_modulus_Pa * scale:.4g} Pa"
+    note = f"calibrated from {path.name} ({key} = {value:.4g}): E = {material.youngs_modulus_Pa * scale:.4g} Pa"
+    return study.with_materials({name: material.scaled(scale, note)}), note
+
+
+def _positive(path: Path, key: str, value) -> float:
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not value > 0:
+        raise ConfigError(f"--calibration {path}: '{key}' must be a positive number, got {value!r}")
+    return float(value)
+
+
+def _calibrated_law(study: Study, path: Path, data: dict) -> tuple[Study, str]:
+    """The study with the material the file names given the file's fitted law (see `apply_calibration`)."""
+    name, law = data["material"], data["law"]
+    if name not in study.materials:
+        raise ConfigError(f"--calibration {path}: fitted to material '{name}', which study '{study.name}' does not "
+                          f"use (its materials: {', '.join(study.materials)})")
+    material = study.materials[name]
+    if not isinstance(law, dict):
+        raise ConfigError(f"--calibration {path}: 'law' must be a table of the fitted parameters")
+    mu = _positive(path, "law/mu_Pa", law.get("mu_Pa"))
+    if law.get("model") != material.law.model:
+        raise ConfigError(f"--calibration {path}: law/model '{law.get('model')}' was fitted, but material '{name}' "
+                          f"has a {material.law.model} law now; explain the bench file again")
+    scale = mu / material.law.shear_modulus_Pa
+    note = f"calibrated from {path.name}: mu = {mu:.4g} Pa, x {scale:.4g} on every modulus of '{name}'"
     return study.with_materials({name: material.scaled(scale, note)}), note
 
 
