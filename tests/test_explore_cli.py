@@ -49,6 +49,19 @@ def test_explore_command(tmp_path):
     assert seen["decision"]["text"].startswith("No solved design meets every requirement. The nearest, 3 beams x 8 mm")
     rerun = CliRunner().invoke(main, args)  # every evaluation and screening comes back from the stored rows
     assert rerun.exit_code == 0 and pd.read_csv(folder / "results.csv").equals(t)
+    # calibrated: NinjaFlex's law at half its moduli; k halves exactly (linear elasticity), outputs apart
+    from seadesign.design.materials import load_material
+
+    law = load_material("ninjaflex").law
+    calibration = tmp_path / "calibration.json"
+    calibration.write_text(json.dumps({"material": "ninjaflex", "law": {"model": law.model,
+                                                                         "mu_Pa": 0.5 * law.shear_modulus_Pa}}))
+    result = CliRunner().invoke(main, [*args, "--calibration", str(calibration)])
+    assert result.exit_code == 0, result.output
+    assert "calibrated from calibration.json: mu = " in result.output and "x 0.5 on every modulus of 'ninjaflex'" in \
+        result.output
+    calibrated = pd.read_csv(tmp_path / "out" / "tinyx-calibrated" / "results.csv")
+    assert calibrated.loc[0, "k_Nm_per_rad"] == pytest.approx(0.5 * t.loc[0, "k_Nm_per_rad"], rel=1e-9)
 
 
 @pytest.mark.slow  # two explorations of one full path each

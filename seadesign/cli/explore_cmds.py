@@ -31,10 +31,14 @@ from seadesign.cli import main
               show_default=True, help="Output root (directory); files go to OUT/<study>/.")
 @click.option("--cache-dir", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Stage cache directory; default $SEADESIGN_CACHE or ~/.cache/seadesign.")
+@click.option("--calibration", type=click.Path(dir_okay=False, exists=True, path_type=Path), default=None,
+              help="Calibration JSON from `seadesign explain --spring`: the material it names takes the fitted law; "
+                   "outputs go to OUT/<study>-calibrated/.")
 @click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0), default=0.01, show_default=True,
               help="STL chordal tolerance in mm.")
 def explore(study: str, budget: int, batch: int | None, seed: int, jobs: int | None, quiet: bool, executor: str,
-            scheduler: str | None, out_dir: Path, cache_dir: Path | None, tolerance_mm: float) -> None:
+            scheduler: str | None, out_dir: Path, cache_dir: Path | None, calibration: Path | None,
+            tolerance_mm: float) -> None:
     """Explore STUDY's design space (lists, ranges and continuous bounds under [design_space]): a design of
     experiments, surrogates of every output, constrained multi-objective search on them, and every proposed
     design verified on the full pipeline, until --budget is spent or the front stops moving. Writes
@@ -49,19 +53,22 @@ def explore(study: str, budget: int, batch: int | None, seed: int, jobs: int | N
     resume = "seadesign " + shlex.join(sys.argv[1:])
     try:
         with stop_on_signals():
-            _explore(study, budget, batch, seed, jobs, quiet, executor, scheduler, out_dir, cache_dir, tolerance_mm)
+            _explore(study, budget, batch, seed, jobs, quiet, executor, scheduler, out_dir, cache_dir, calibration,
+                     tolerance_mm)
     except Interrupted as stop:
         click.echo(f"stopped by {stop.signal}; finished evaluations are saved; resume with: {resume}", err=True)
         click.get_current_context().exit(stop.exit_code)
 
 
 def _explore(study: str, budget: int, batch: int | None, seed: int, jobs: int | None, quiet: bool, executor: str,
-             scheduler: str | None, out_dir: Path, cache_dir: Path | None, tolerance_mm: float) -> None:
+             scheduler: str | None, out_dir: Path, cache_dir: Path | None, calibration: Path | None,
+             tolerance_mm: float) -> None:
     """The explore command's work (`explore.pipeline`; see `explore`)."""
     from seadesign.explore.pipeline import run_exploration
 
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
     result = run_exploration(study, budget, batch=batch, seed=seed, jobs=jobs, quiet=quiet, executor=executor,
-                             scheduler=scheduler, out_dir=out_dir, cache_dir=cache_dir, tolerance_mm=tolerance_mm)
+                             scheduler=scheduler, out_dir=out_dir, cache_dir=cache_dir, tolerance_mm=tolerance_mm,
+                             calibration=calibration)
     for line in result.lines(quiet):
         click.echo(line)

@@ -33,12 +33,15 @@ class ExplorationResult:
         Where the outputs are.
     written : dict of str to list of Path
         The files written, by kind (tables, images, spring, cad).
+    calibration : str
+        With a calibration: which material was calibrated, and how (empty without).
     """
 
     study: Study
     run: StudyExploration
     folder: Path
     written: dict[str, list[Path]]
+    calibration: str = ""
 
     def lines(self, quiet: bool = False) -> list[str]:
         """What `seadesign explore` prints when it is done.
@@ -67,6 +70,8 @@ class ExplorationResult:
                f"stop: {self.run.exploration.stop_reason}",
                headline(t, self.run.decision, column_label(objective), objective),
                self.run.decision.predicted]
+        if self.calibration:
+            out.insert(0, self.calibration)
         if not quiet:
             out += [f"wrote {p}" for paths in self.written.values() for p in paths]
         return out
@@ -130,7 +135,8 @@ class ExplorationResult:
 def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int | None = None, seed: int = 0,
                     jobs: int | None = None, quiet: bool = False, executor: str = "local",
                     scheduler: str | None = None, out_dir: str | Path = Path("exports"),
-                    cache_dir: str | Path | None = None, tolerance_mm: float = 0.01) -> ExplorationResult:
+                    cache_dir: str | Path | None = None, tolerance_mm: float = 0.01,
+                    calibration: str | Path | None = None) -> ExplorationResult:
     """Explore a study's design space (lists, ranges and continuous bounds under ``[design_space]``) and write
     the results, as `seadesign explore`: a design of experiments, surrogates of every output, constrained
     multi-objective search on them, every proposal verified on the full pipeline, until the budget is spent or
@@ -160,6 +166,9 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
         Stage cache folder; None: $SEADESIGN_CACHE, else ~/.cache/seadesign.
     tolerance_mm : float
         STL chordal tolerance (mm).
+    calibration : str or Path, optional
+        Calibration JSON (from `explain`): the material it names takes the fitted law (`apply_calibration`);
+        outputs go to ``out_dir/<study>-calibrated/``.
 
     Returns
     -------
@@ -169,7 +178,7 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
     Raises
     ------
     ConfigError
-        The study is invalid (the message names the key) or `budget` is below 2.
+        The study or the calibration is invalid (the message names the key) or `budget` is below 2.
     Interrupted
         A signal stopped it; finished evaluations are saved and a rerun resumes.
 
@@ -190,12 +199,17 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
     if budget < 2:
         raise ConfigError(f"budget must be at least 2 full-path evaluations, got {budget}")
     study = study if isinstance(study, Study) else load_study(study)
+    note = ""
+    if calibration is not None:
+        from seadesign.sweep.pipeline import apply_calibration
+
+        study, note = apply_calibration(study, calibration)
     cache = default_cache(cache_dir)
     solver = SolverSettings()
-    folder = Path(out_dir) / study.name
+    folder = Path(out_dir) / (f"{study.name}-calibrated" if calibration is not None else study.name)
     loop = LoopSettings(budget=budget, batch=batch or jobs or default_jobs(), seed=seed)
     run = explore_study(study, folder, loop, solver=solver, cache=cache, executor=executor, jobs=jobs,
                         scheduler=scheduler, quiet=quiet)
     written = write_exploration(study, run.problem, run.exploration, run.decision, run.sobol, folder, run.settings,
                                 solver=solver, cache=cache, tolerance_mm=tolerance_mm)
-    return ExplorationResult(study, run, folder, written)
+    return ExplorationResult(study, run, folder, written, note)
