@@ -68,7 +68,17 @@ def test_explain_generic_table_and_bad_column(tmp_path):
     assert bad.exit_code != 0 and "predicted column 'nope'" in bad.output
 
 
-def test_thesis_worked_example(tmp_path, spring_file):
+@pytest.mark.parametrize("with_curve", [False, True])
+def test_thesis_worked_example(tmp_path, spring_file, spring_dict, with_curve):
+    """The worked case on a spring.json with k, and on one that carries its design's torque curve (the default
+    sweep's): the thesis's FEA and bench were linear, so the curve plays no part."""
+    if with_curve:
+        from seadesign.design.spring import write_spring
+
+        theta = np.linspace(0.0, 0.25, 6)
+        curve = {"rotation_rad": theta.tolist(), "torque_Nm": (30.0 * theta * (1 - theta)).tolist(),
+                 "source": "fea_large_deflection", "stop_reason": "bifurcation", "hard_stop": False}
+        spring_file = write_spring({**spring_dict, "schema_version": 2, "torque_curve": curve}, tmp_path / "curve.json")
     res = CliRunner().invoke(main, ["explain-thesis", "--spring", str(spring_file), "-o", str(tmp_path)])
     assert res.exit_code == 0, res.output
     cal = json.loads((tmp_path / "thesis_calibration.json").read_text())

@@ -27,10 +27,16 @@ K_FEA_NM_PER_RAD = XH540_STALL_TORQUE_NM / (THESIS_FEA_RESULTS[(9, 8.0)][1] * 1e
 DEAD_BAND_RAD = 0.03
 
 
+def linear(spring: dict[str, Any], k_Nm_per_rad: float) -> dict[str, Any]:
+    """`spring` (a spring.json dict) as a linear spring of stiffness k: the thesis's FEA and bench were linear, so a
+    torque curve of the given design is dropped."""
+    return {key: value for key, value in spring.items() if key != "torque_curve"} | {"k_Nm_per_rad": k_Nm_per_rad}
+
+
 def thesis_spring(spring: dict[str, Any]) -> dict[str, Any]:
-    """`spring` (a spring.json dict) with the thesis FEA's k and material."""
+    """`spring` (a spring.json dict) with the thesis FEA's k and material, linear."""
     material = load_material("generic_tpu")
-    return {**spring, "k_Nm_per_rad": K_FEA_NM_PER_RAD, "k_source": "fea", "material": material.to_handoff()}
+    return {**linear(spring, K_FEA_NM_PER_RAD), "k_source": "fea", "material": material.to_handoff()}
 
 
 def worked_example(spring: dict[str, Any], out_dir: Path, seed: int = 0) -> tuple[Explanation, dict[str, Any]]:
@@ -40,8 +46,7 @@ def worked_example(spring: dict[str, Any], out_dir: Path, seed: int = 0) -> tupl
     """
     out_dir = Path(out_dir)
     chain = bench_effects(THESIS_K_MEASURED_NM_PER_RAD).configure("dead_band", enabled=True, width_rad=DEAD_BAND_RAD)
-    table, meta = simulate_bench({**spring, "k_Nm_per_rad": THESIS_K_MEASURED_NM_PER_RAD}, BenchProtocol(), effects=chain,
-                                 seed=seed)
+    table, meta = simulate_bench(linear(spring, THESIS_K_MEASURED_NM_PER_RAD), BenchProtocol(), effects=chain, seed=seed)
     write_bench(table, out_dir / "thesis_bench.csv", meta)
     fea = thesis_spring(spring)
     ex = explain(bench_loop_data(table, fea))
