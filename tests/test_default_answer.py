@@ -57,3 +57,28 @@ def test_the_default_study_answer_and_its_handoff(tmp_path):
         assert not (tmp_path / "m").exists()
     if not data:
         pytest.skip(f"train with --data: the reference recordings are not present ({RECORDINGS[0].parent})")
+
+
+def _documented_calibration_lines() -> list[str]:
+    """The printed lines of the worked calibration in docs/explanation/loop.md (its block starting "calibration:")."""
+    page = (Path(__file__).resolve().parents[1] / "docs" / "explanation" / "loop.md").read_text()
+    block = page.split("```\ncalibration:", 1)[1].split("```", 1)[0]
+    return [line.strip() for line in ("calibration:" + block).splitlines() if line.strip()]
+
+
+@pytest.mark.slow
+def test_the_documented_calibration_example_prints_what_the_docs_show(tmp_path):
+    """The docs' worked calibration, run as the page says: `explain-thesis` on the default sweep's spring.json
+    (cached), then `sweep --calibration` with its calibration; the choice lines it prints are the page's. The
+    calibrated sweep recomputes every candidate on the cached meshes (about 10 minutes on 2 cores)."""
+    out = tmp_path / "exports"
+    assert CliRunner().invoke(main, ["sweep", "--quiet", "--out", str(out)]).exit_code == 0
+    thesis = CliRunner().invoke(main, ["explain-thesis", "--spring", str(out / "wolfgang_knee" / "spring.json"), "-o",
+                                       str(tmp_path / "thesis")])
+    assert thesis.exit_code == 0, thesis.output
+    result = CliRunner().invoke(main, ["sweep", "--quiet", "--out", str(out), "--calibration",
+                                       str(tmp_path / "thesis" / "thesis_calibration.json")])
+    assert result.exit_code == 0, result.output
+    printed = [line.strip() for line in result.output.splitlines()]
+    for line in _documented_calibration_lines():
+        assert line in printed, f"{line!r} is not printed; update docs/explanation/loop.md to:\n{result.output}"

@@ -168,3 +168,22 @@ def test_strike_torque_of_a_path_that_ends_at_a_limit_point():
         exact = a * math.sin(math.acos(1 - energy / (a * b)))
         # PCHIP through 21 points: measured 8.7e-6 and 2.1e-5 relative
         assert strike_torque(row, energy) == pytest.approx(exact, rel=6e-5)
+
+
+def test_the_standing_verdict_says_where_a_path_ends_below_the_standing_torque():
+    """A curve that ends below the standing torque has no standing deflection: the verdict says where and why the
+    path ended instead of printing nan."""
+    import pandas as pd
+
+    from seadesign.design.study import load_study
+    from seadesign.sweep.rank import standing_verdict
+
+    study = load_study()
+    ranked = pd.DataFrame({"candidate": ["short", "long"], "k_Nm_per_rad": [8.02, 30.0],
+                           "standing_deflection_deg": [float("nan"), 4.0], "standing_knee_torque_Nm": [2.07, 2.07],
+                           "large_stop_torque_Nm": [1.71, 7.1], "large_stop_reason": ["contact", "contact"]})
+    assert standing_verdict(ranked, "short", study) == (
+        "short: k 8.02 Nm/rad, its path ends at 1.71 Nm (contact), below the standing torque 2.07 Nm: does NOT carry "
+        "the standing load")
+    assert standing_verdict(ranked, "long", study).endswith("standing deflection 4 deg under 2.07 Nm (limit 10 deg): "
+                                                            "carries the standing load")

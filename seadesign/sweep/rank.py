@@ -233,6 +233,10 @@ def standing_verdict(ranked: pd.DataFrame, candidate: str, study: Study) -> str:
         verdict, limit_words = ("carries" if np.isfinite(deg) else "does NOT carry"), "no sag limit"
     else:
         verdict, limit_words = ("carries" if deg < limit else "does NOT carry"), f"limit {limit:g} deg"
+    if not np.isfinite(deg):  # the path ends below the standing torque: no deflection to judge
+        return (f"{candidate}: k {row['k_Nm_per_rad']:.4g} Nm/rad, its path ends at {row['large_stop_torque_Nm']:.3g} "
+                f"Nm ({row['large_stop_reason']}), below the standing torque {row['standing_knee_torque_Nm']:.3g} Nm: "
+                "does NOT carry the standing load")
     return (f"{candidate}: k {row['k_Nm_per_rad']:.4g} Nm/rad, standing deflection {deg:.3g} deg under "
             f"{row['standing_knee_torque_Nm']:.3g} Nm ({limit_words}): {verdict} the standing load")
 
