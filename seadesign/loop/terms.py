@@ -62,9 +62,10 @@ WHOLE_RECORD = frozenset({"hysteresis", "viscoelastic", "thermal_softening", "se
 def whole_record(terms: list[Term], data: LoopData) -> bool:
     """Whether `terms` on `data` need the whole record (else the fitted rows alone will do)."""
     keys = {t.key for t in terms}
-    return bool(keys & WHOLE_RECORD) or any(t.on_torque for t in terms) or (data.direction == "compliance" and "friction" in keys) or \
-        (data.sensor_on == "deflection" and data.spring is not None and bool(keys & {k for k, v in PLACES.items()
-                                                                                      if v == "sensor"}))
+    sensors = {k for k, v in PLACES.items() if v == "sensor"}
+    return bool(keys & WHOLE_RECORD) or any(t.on_torque for t in terms) or \
+        (data.direction == "compliance" and "friction" in keys) or \
+        (data.sensor_on == "deflection" and data.spring is not None and bool(keys & sensors))
 
 
 @dataclass(frozen=True)
