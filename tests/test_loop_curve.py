@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from helpers_generators import K, robot
-from seadesign.loop import LoopInputError, explain
+from seadesign.effects import CurveRangeError
+from seadesign.loop import explain
 from seadesign.loop.sea import robot_loop_data
 
 K3 = -80.0  # the generator's spring softens: T = k d + K3 d^3 (monotone up to 0.19 rad)
@@ -57,8 +58,8 @@ def test_data_past_the_curve_are_left_out_not_extrapolated(spring_dict, softenin
     scale = ex.final.parameters()["stiffness_scale"]["scale"]
     assert abs(scale["value"] - 1.0) <= 3 * scale["uncertainty"]  # measured 1.0048 +- 0.0038
     assert "left out of the fit" in ex.verdict()
-    with pytest.raises(LoopInputError, match=r"only \d+ of 6000 samples \(45%\) lie within the spring's torque curve, "
-                                             r"which covers deflections up to 0\.03 rad"):
+    with pytest.raises(CurveRangeError, match=r"\d+ of 6000 samples \(55%\) are past the spring's torque curve, "
+                                              r"which covers deflections up to 0\.03 rad"):
         robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.03)})
     stop = robot_loop_data(softening_knee, {**spring_dict, "torque_curve": curve(0.05, hard_stop=True)})
     assert stop.in_range.all() and stop.coverage is None  # a hard stop holds the rotation at the end instead

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from helpers_generators import bench, bench_curve
-from seadesign.loop import LoopInputError, explain
+from seadesign.effects import CurveRangeError
+from seadesign.loop import explain
 from seadesign.loop.sea import bench_loop_data
 
 SCALES = [0.2, 0.5, 2.0, 3.0]
@@ -72,6 +73,6 @@ def test_bench_data_past_the_curve_are_left_out_and_counted(spring_dict):
 
 def test_a_record_mostly_past_the_curve_is_refused_with_the_range(spring_dict):
     df = bench_curve(softening_torque, 0.5, amplitude_rad=1.2, seed=4)
-    with pytest.raises(LoopInputError, match=r"lie within the spring's torque curve, which covers deflections up to "
-                                             r"0\.3 rad \(6\.84 Nm; it ends with stop reason 'bifurcation'\)"):
+    with pytest.raises(CurveRangeError, match=r"are past the spring's torque curve, which covers deflections up to "
+                                              r"0\.3 rad \(6\.84 Nm; it ends with stop reason 'bifurcation'\)"):
         bench_loop_data(df, {**spring_dict, "torque_curve": CURVE})

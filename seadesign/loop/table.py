@@ -25,7 +25,7 @@ import pandas as pd
 from scipy.ndimage import convolve1d
 from scipy.signal import savgol_coeffs, savgol_filter
 
-from seadesign.effects import SIGNALS, Effect, Scales
+from seadesign.effects import SIGNALS, CurveRangeError, Effect, Scales
 from seadesign.errors import DataError
 
 #: the signals the loop reads (a subset of the effect library's vocabulary) -> meaning (unit)
@@ -135,8 +135,8 @@ class LoopData:
 
     def _cover(self, curve) -> None:
         """Leave out the samples whose measured deflection lies past the torque curve's end (nothing is
-        extrapolated), and evaluate the curve clamped for a fitter's trial values; refuse a record of which
-        fewer than `MIN_IN_RANGE` lie on the curve."""
+        extrapolated), and evaluate the curve clamped for a fitter's trial values; a record of which fewer than
+        `MIN_IN_RANGE` lie on the curve is a CurveRangeError."""
         if self.direction == "compliance":
             deflection = self.sign * (self.measured - (0.0 if self.base is None else self.base))
         else:
@@ -148,12 +148,12 @@ class LoopData:
         self.in_range = deflection <= curve.end_rotation_rad
         n_in = int(self.in_range.sum())
         if n_in < MIN_IN_RANGE * self.n:
-            raise LoopInputError(
-                f"only {n_in} of {self.n} samples ({n_in / self.n:.0%}) lie within the spring's torque curve, which "
-                f"covers deflections up to {curve.end_rotation_rad:.4g} rad ({curve.end_torque_Nm:.4g} Nm; it ends "
-                f"with stop reason '{curve.stop_reason}'); the measured deflection reaches {deflection.max():.4g} "
-                f"rad. The loop needs at least {MIN_IN_RANGE:.0%} of the record on the model: compute the curve "
-                "further, or test over the range it covers")
+            raise CurveRangeError(
+                f"{self.n - n_in} of {self.n} samples ({1 - n_in / self.n:.0%}) are past the spring's torque curve, "
+                f"which covers deflections up to {curve.end_rotation_rad:.4g} rad ({curve.end_torque_Nm:.4g} Nm; it "
+                f"ends with stop reason '{curve.stop_reason}'); the measured deflection reaches "
+                f"{deflection.max():.4g} rad. The loop needs at least {MIN_IN_RANGE:.0%} of the record on the model: "
+                "compute the curve further, or test over the range it covers")
         if n_in < self.n:
             out = ~self.in_range
             self.coverage = CurveCoverage(int(out.sum()), self.n, curve.end_rotation_rad, curve.end_torque_Nm,
