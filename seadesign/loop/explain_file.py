@@ -4,7 +4,6 @@ refitted, missing effects traced, the report and the calibration JSON written.""
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -218,8 +217,7 @@ def explain_file(file: str | Path, spring: str | Path | None = None, *, out_dir:
             loop_plot, stem = False, f"{file.stem}_{knee}"
     out_dir = Path(out_dir) if out_dir else Path("exports") / "explain" / stem
     ex = explain(data, declared, exclude=exclude, min_gain=min_gain)
-    cal = calibration(ex, spring_doc, str(file), hashlib.sha256(file.read_bytes()).hexdigest()) \
-        if spring_doc is not None else None
+    cal = calibration(ex, spring_doc, file) if spring_doc is not None else None
     files = write_report(ex, out_dir, stem, f"Explain {file.name}", loop_plot=loop_plot, calibration=cal)
     if json_out is not None:
         json_out = Path(json_out)

@@ -17,6 +17,8 @@ one (`SpringCurve`, PCHIP): the model's spring either way, its stiffness scale a
 
 from __future__ import annotations
 
+import hashlib
+from pathlib import Path
 from typing import Any
 
 import pandas as pd
@@ -96,31 +98,29 @@ def fitted_law(material: Material, spring_modulus_Pa: float, scale: float, scale
     the initial shear modulus mu = 2 (C10 + C01). Exact for a torque curve: a hyperelastic law's stresses scale
     with its moduli when its compressibilities scale inversely, so the path's torque scales and its shape stays."""
     factor = spring_modulus_Pa * scale / material.youngs_modulus_Pa
-    law = material.law
+    fitted = material.scaled(factor, "fitted")
+    law = fitted.law
     relative = scale_uncertainty / scale
     out: dict[str, Any] = {"model": law.model, "factor_on_material_file": factor}
     for name in ("c10_Pa", "c01_Pa", "c20_Pa", "c30_Pa"):
         if getattr(law, name):
-            value = getattr(law, name) * factor
-            out[name], out[name.replace("_Pa", "_uncertainty_Pa")] = value, value * relative
-    for name in ("d1_per_Pa", "d2_per_Pa", "d3_per_Pa"):
-        if getattr(law, name):
-            out[name] = getattr(law, name) / factor
-    out["mu_Pa"] = law.shear_modulus_Pa * factor
+            out[name], out[name.replace("_Pa", "_uncertainty_Pa")] = getattr(law, name), getattr(law, name) * relative
+    out |= {name: getattr(law, name) for name in ("d1_per_Pa", "d2_per_Pa", "d3_per_Pa") if getattr(law, name)}
+    out["mu_Pa"] = law.shear_modulus_Pa
     out["mu_uncertainty_Pa"] = out["mu_Pa"] * relative
-    out["youngs_modulus_Pa"] = material.youngs_modulus_Pa * factor  # the linear solve's, following mu
+    out["youngs_modulus_Pa"] = fitted.youngs_modulus_Pa  # the linear solve's, following mu
     out["fitted"] = ["one factor on every modulus (the curve's scale)"]
     out["note"] = LAW_NOTE
     return out
 
 
-def calibration(ex: Explanation, spring: dict[str, Any], source: str, source_sha256: str = "",
+def calibration(ex: Explanation, spring: dict[str, Any], source: Path,
                 material: Material | None = None) -> dict[str, Any]:
     """The calibration JSON for `seadesign sweep --calibration`: `stiffness_scale` (fitted k / model k; the
     fitted value whether or not it differs significantly), the material calibrated and its fitted law
     (`fitted_law`: the spring's material, found by its name, unless `material` is given: the fitted modulus
-    expressed as that material's law), the measured file's SHA-256, and every fitted parameter with unit and
-    uncertainty."""
+    expressed as that material's law), the measured file `source` and its SHA-256, and every fitted parameter with
+    unit and uncertainty."""
     params = ex.final.parameters()
     k = float(spring["k_Nm_per_rad"])
     scale = params.get("stiffness_scale", {}).get("scale", {"value": 1.0, "uncertainty": 0.0})
@@ -130,8 +130,8 @@ def calibration(ex: Explanation, spring: dict[str, Any], source: str, source_sha
         "stiffness_scale_correlated_with": scale.get("correlated_with", {}),
         "k_model_Nm_per_rad": k,
         "k_fitted_Nm_per_rad": k * scale["value"],
-        "source": source,
-        "source_sha256": source_sha256,
+        "source": str(source),
+        "source_sha256": hashlib.sha256(Path(source).read_bytes()).hexdigest(),
         "effects_found": ex.found,
         "declared": [{"name": c.name, "effect": c.key, "declared": c.declared, "supported": c.supported,
                       "fitted": c.fitted} for c in ex.declared],

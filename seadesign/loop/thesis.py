@@ -9,7 +9,6 @@ with the FEA's k: it must find the stiffness scale (9.106 / 464 ~ 0.0196) and th
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 from typing import Any
 
@@ -52,8 +51,7 @@ def worked_example(spring: dict[str, Any], out_dir: Path, seed: int = 0) -> tupl
     ex = explain(bench_loop_data(table, fea))
     bench = out_dir / "thesis_bench.csv"
     # the printed part's fitted modulus, expressed as the law of the given spring's material
-    cal = calibration(ex, fea, str(bench), hashlib.sha256(bench.read_bytes()).hexdigest(),
-                      material=load_material(spring["material"]["name"]))
+    cal = calibration(ex, fea, bench, material=load_material(spring["material"]["name"]))
     write_report(ex, out_dir, "thesis", "Thesis case: FEA spring (generic TPU) vs bench with measured k and a dead-band",
                  loop_plot=True, calibration=cal)
     return ex, cal
