@@ -233,8 +233,17 @@ def test_a_calibrated_law_replaces_only_its_material(tmp_path):
                                           "does not use \\(its materials: ninjaflex, cheetah\\)"):
         apply_calibration(study, tmp_path / "other.json")
     (tmp_path / "model.json").write_text(json.dumps({"material": "ninjaflex", "law": {"model": "yeoh", "mu_Pa": 1e6}}))
-    with pytest.raises(ConfigError, match="law/model 'yeoh' was fitted"):
+    with pytest.raises(ConfigError, match="law/model 'yeoh' was fitted, but 'law' lacks c10_Pa, c20_Pa, d1_per_Pa"):
         apply_calibration(study, tmp_path / "model.json")
+    # a law of another family (its shape fitted too) replaces the material's own, with E following mu
+    yeoh = {"model": "yeoh", "c10_Pa": 5e5, "c20_Pa": -2e4, "d1_per_Pa": 4e-8, "mu_Pa": 1e6}
+    (tmp_path / "yeoh.json").write_text(json.dumps({"material": "ninjaflex", "law": yeoh}))
+    law = apply_calibration(study, tmp_path / "yeoh.json")[0].materials["ninjaflex"]
+    assert (law.law.model, law.law.c10_Pa, law.law.c20_Pa, law.law.d1_per_Pa) == ("yeoh", 5e5, -2e4, 4e-8)
+    assert law.youngs_modulus_Pa == pytest.approx(1e6 / ninjaflex.law.shear_modulus_Pa * ninjaflex.youngs_modulus_Pa)
+    (tmp_path / "mu.json").write_text(json.dumps({"material": "ninjaflex", "law": {**yeoh, "mu_Pa": 2e6}}))
+    with pytest.raises(ConfigError, match="is not 2 \\(C10 \\+ C01\\)"):
+        apply_calibration(study, tmp_path / "mu.json")
     (tmp_path / "old.json").write_text(json.dumps({"youngs_modulus_Pa": 6e6}))
     with pytest.raises(ConfigError, match="does not name the material it was fitted to"):
         apply_calibration(study, tmp_path / "old.json")

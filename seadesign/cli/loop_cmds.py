@@ -60,10 +60,14 @@ def _pairs(items: tuple[str, ...], option: str) -> dict[str, str]:
 @click.option("--plain", is_flag=True, help="Robot files: declare nothing but the spring (k refitted).")
 @click.option("--min-gain", type=click.FloatRange(0.0, 1.0), default=0.05, show_default=True,
               help="Relative held-out RMSE cut (fraction) an effect needs to be added.")
+@click.option("--law", type=click.Choice(["auto", "scale", "mooney_rivlin", "yeoh"]), default="auto", show_default=True,
+              help="Bench files with a torque curve: trace the material law's shape beside its scale (auto: "
+                   "Mooney-Rivlin C01 and Yeoh C20; recomputes the spring's part for trial laws, so its study must "
+                   "load and still give spring.json's curve), or fit the scale alone (scale).")
 def explain_cmd(file: Path, spring_path: Path | None, json_out: Path | None, out_dir: Path, predict: str, knee: str,
                 keep_lifted: bool | None, measured: str | None, predicted: str | None, signals: tuple[str, ...],
                 units: tuple[str, ...], measured_unit: str, declare: tuple[str, ...], plain: bool,
-                min_gain: float) -> None:
+                min_gain: float, law: str) -> None:
     """Explain the residual between a model and measured FILE: the declared model refitted, missing effects,
     error before and after.
 
@@ -75,7 +79,7 @@ def explain_cmd(file: Path, spring_path: Path | None, json_out: Path | None, out
                          keep_lifted=keep_lifted, measured=measured, predicted=predicted,
                          signals=_pairs(signals, "--signal") if generic else None,
                          units=_pairs(units, "--unit") if generic else None, measured_unit=measured_unit,
-                         declare=declare, plain=plain, min_gain=min_gain)
+                         declare=declare, plain=plain, min_gain=min_gain, law=law)
     for line in found.lines():
         click.echo(line)
 

@@ -212,6 +212,27 @@ class PathIncrements:
     residual_rtol: float = 1e-7
 
 
+#: a compressibility that leaves its volumetric term out of CalculiX's energy (1/Pa)
+ABSENT_D_PER_PA = 1e30
+
+
+def hyperelastic_card(law: Hyperelastic) -> str:
+    """The *HYPERELASTIC card of `law` in CalculiX's constants (moduli Pa, compressibilities 1/Pa): NEO HOOKE
+    (C10, D1), MOONEY-RIVLIN (C10, C01, D1) or YEOH (C10, C20, C30, D1, D2, D3). A term our law leaves out (D2 or
+    D3 = 0) is written as D = 1e30 1/Pa, which leaves it out to double precision: CalculiX does not read D = 0 as
+    absent (measured: a Yeoh law with C20 = 0 and D2 = D3 = 0 gave 32 % more torque than the same neo-Hookean law)."""
+    def d(value: float) -> float:
+        return value if value > 0 else ABSENT_D_PER_PA
+
+    rows = {"neo_hooke": ("NEO HOOKE", (law.c10_Pa, law.d1_per_Pa)),
+            "mooney_rivlin": ("MOONEY-RIVLIN", (law.c10_Pa, law.c01_Pa, law.d1_per_Pa)),
+            "yeoh": ("YEOH", (law.c10_Pa, law.c20_Pa, law.c30_Pa, law.d1_per_Pa, d(law.d2_per_Pa), d(law.d3_per_Pa)))}
+    if law.model not in rows:
+        raise SolverError(f"the NLGEOM export writes neo_hooke, mooney_rivlin or yeoh laws; the law is {law.model!r}")
+    name, constants = rows[law.model]
+    return f"*HYPERELASTIC, {name}\n" + ", ".join(f"{c:.12e}" for c in constants) + "\n"
+
+
 def write_path_inp(
     path: Path,
     emesh: ElementMesh,
@@ -221,14 +242,12 @@ def write_path_inp(
     rotations_rad: Sequence[float],
     increments: PathIncrements = PathIncrements(),
 ) -> Path:
-    """Write a CalculiX NLGEOM deck of the rotation path: the neo-Hookean law (C10 in Pa, D1 in 1/Pa;
+    """Write a CalculiX NLGEOM deck of the rotation path: the hyperelastic law (`hyperelastic_card`;
     C3D10 integrates it at every point, as the path's formulation "full"), the ring nodes held, the hub
     nodes' u_z = 0, and one *STEP, NLGEOM per rotation (rad, increasing) that ends with every hub node
     at x' = R(theta) x about z (within a step the displacements ramp linearly: only step ends are
     read). Each step prints the hub nodes' displacements and reaction forces at its end only."""
-    if law.model != "neo_hooke":
-        raise SolverError(f"the NLGEOM export writes *HYPERELASTIC, NEO HOOKE; the law is {law.model!r} "
-                          "(use a neo-Hookean law, e.g. Hyperelastic.from_linear)")
+    card = hyperelastic_card(law)
     theta = np.asarray(rotations_rad, dtype=float)
     if theta.ndim != 1 or not len(theta) or theta[0] <= 0 or np.any(np.diff(theta) <= 0):
         raise SolverError(f"rotations_rad must be positive and increasing, got {theta}")
@@ -241,7 +260,7 @@ def write_path_inp(
         f.write("*HEADING\nseadesign rotation path: HUB turned about +z (x' = R(theta) x), RING held; NLGEOM; "
                 "units m, N, Pa\n")
         _write_mesh(f, emesh, hub, ring_nodes)
-        f.write(f"*MATERIAL, NAME=SPRING\n*HYPERELASTIC, NEO HOOKE\n{law.c10_Pa:.12e}, {law.d1_per_Pa:.12e}\n")
+        f.write(f"*MATERIAL, NAME=SPRING\n{card}")
         f.write("*SOLID SECTION, ELSET=EALL, MATERIAL=SPRING\n*BOUNDARY\nRING, 1, 3\nHUB, 3, 3\n")
         for before, t in zip(np.concatenate([[0.0], theta[:-1]]), theta):
             c, s = np.cos(t), np.sin(t)

@@ -65,6 +65,7 @@ class LargeDeflection:
     curve_rotation_rad: tuple[float, ...] = unscaled()
     curve_torque_Nm: tuple[float, ...] = unscaled()
     curve_tangent_Nm_per_rad: tuple[float, ...] = unscaled()  # dT/dtheta at each point
+    curve_tensile_strain: tuple[float, ...] = unscaled()  # the part's largest tensile principal strain at each point
     stop_reason: str = unscaled()  # see fea.rotation_path
     stop_rotation_rad: float = unscaled()
     stop_torque_Nm: float = unscaled()
@@ -176,6 +177,7 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
         curve_rotation_rad=tuple(map(float, theta)),
         curve_torque_Nm=tuple(map(float, torque)),
         curve_tangent_Nm_per_rad=tuple(float(p.tangent_Nm_per_rad) for p in pts),
+        curve_tensile_strain=tuple(map(float, tensile)),
         stop_reason=path.stop_reason,
         stop_rotation_rad=path.stop_rotation_rad,
         stop_torque_Nm=path.stop_torque_Nm,

@@ -34,7 +34,7 @@ from seadesign.effects import Effect, SensorStep, StiffnessScale
 from seadesign.loop.changepoint import best_split
 from seadesign.loop.model import EffectModel, Fit, evaluate
 from seadesign.loop.table import LoopData, LoopInputError, time_blocks
-from seadesign.loop.terms import CANDIDATES, Term, applicable
+from seadesign.loop.terms import CANDIDATES, LAW_SHAPES, Term, applicable
 from seadesign.loop.whiteness import residual_tests
 
 SCALE = "stiffness_scale"
@@ -145,6 +145,7 @@ class Explanation:
             text += f" Declared but unsupported by the data: {', '.join(self.unsupported)}."
         if self.data.coverage is not None:
             text += " " + self.data.coverage.text()
+        text += "".join(" " + note for note in self.data.notes)
         if not self.final.converged:
             text += " The final fit did not converge (evaluation limit): its numbers are not a result."
         s = self.tests_after["strongest"]
@@ -159,6 +160,8 @@ class Explanation:
 
 def _term(key: str, data: LoopData, current: Fit) -> Term | None:
     """A fresh candidate term for `key` (a sensor step at the instant the current residual jumps)."""
+    if key in LAW_SHAPES:
+        return Term(key, data.shapes[key])
     if key != "sensor_step":
         return Term.of(key)
     taken = [current.values[t.name]["time_s"] for t in current.terms if t.key == "sensor_step"]
@@ -220,13 +223,13 @@ def explain(data: LoopData, declared: Sequence[Effect] = (), *, exclude: Sequenc
     """Run the loop on `data` with the `declared` effects (library effects with their declared values);
     `exclude`: library keys not traced (effects a generic table's prediction already holds)."""
     for key in [*exclude, *(candidates or [])]:
-        if key not in CANDIDATES:
-            raise LoopInputError(f"unknown effect '{key}'; the loop traces: {', '.join(sorted(CANDIDATES))}")
+        if key not in CANDIDATES + LAW_SHAPES:
+            raise LoopInputError(f"unknown effect '{key}'; the loop traces: {', '.join(sorted(CANDIDATES + LAW_SHAPES))}")
     held = time_blocks(data.n, n_blocks, held_out_blocks)
     decl = ([Term(SCALE, StiffnessScale(), declared=True)] if applicable(SCALE, data) else []) + \
            [Term(e.name, e, declared=True) for e in declared]
     declared_keys = {t.key for t in decl}
-    pool = [k for k in CANDIDATES if applicable(k, data) and k not in declared_keys and k not in exclude
+    pool = [k for k in CANDIDATES + LAW_SHAPES if applicable(k, data) and k not in declared_keys and k not in exclude
             and (candidates is None or k in candidates)]
     plain = evaluate(data, decl, {t.name: dict(t.effect.values) for t in decl}, held)
     base = _fit(data, decl, held)
@@ -262,9 +265,10 @@ def _trace(data: LoopData, held: np.ndarray, current: Fit, pool: list[str], gate
     scale held), then the `screen` best and every one the screen already accepts refitted with all free."""
     held_values = {t.name: current.values[t.name] for t in current.terms if t.declared and t.key != SCALE}
     screened = []
+    taken = {t.candidate for t in current.terms}
     for key in pool:
-        if key in {t.candidate for t in current.terms} and key != "sensor_step":
-            continue
+        if key in taken and key != "sensor_step" or key in LAW_SHAPES and taken & set(LAW_SHAPES):
+            continue  # one law shape at a time
         term = _term(key, data, current)
         if term is None:
             continue

@@ -14,6 +14,7 @@ from seadesign.data import clean, is_hanging, read_bench, read_recording
 from seadesign.design.spring import load_spring
 from seadesign.errors import ConfigError
 from seadesign.loop.engine import Explanation, explain
+from seadesign.loop.law_family import FAMILIES, bench_shapes
 from seadesign.loop.report import write_report
 from seadesign.loop.sea import ROBOT_DECLARED, bench_loop_data, calibration, robot_declared, robot_loop_data
 from seadesign.loop.table import ROLES, LoopData, from_frame
@@ -133,7 +134,7 @@ def explain_file(file: str | Path, spring: str | Path | None = None, *, out_dir:
                  keep_lifted: bool | None = None, measured: str | None = None, predicted: str | None = None,
                  signals: dict[str, str] | None = None, units: dict[str, str] | None = None,
                  measured_unit: str = "1", declare: tuple[str, ...] = (), plain: bool = False,
-                 min_gain: float = 0.05) -> FileExplanation:
+                 min_gain: float = 0.05, law: str = "auto") -> FileExplanation:
     """Explain the residual between a model and a measured file: the declared model refitted, missing effects
     traced, the error before and after, as `seadesign explain FILE`; writes the report and, for bench and
     robot files, the calibration JSON that `sweep_study(calibration=...)` reads.
@@ -170,6 +171,10 @@ def explain_file(file: str | Path, spring: str | Path | None = None, *, out_dir:
         Robot files: declare nothing but the spring (k refitted).
     min_gain : float
         Relative held-out RMSE cut (fraction, 0-1) an effect needs to be added.
+    law : {"auto", "scale", "mooney_rivlin", "yeoh"}
+        Bench files predicting torque, with a spring.json that has a torque curve: the material law's shape traced
+        beside the scale (``auto``: Mooney-Rivlin and Yeoh; each needs the spring's study, to recompute its part's
+        path for trial laws), or the scale alone (``scale``).
 
     Returns
     -------
@@ -183,6 +188,8 @@ def explain_file(file: str | Path, spring: str | Path | None = None, *, out_dir:
         role, or a file of neither kind (each named).
     SpringFileError, DataError
         spring.json or the measured file cannot be read (named).
+    SpringSourceError
+        The law's shape is asked for, but spring.json's study cannot be loaded or no longer gives its curve.
 
     Examples
     --------
@@ -191,6 +198,8 @@ def explain_file(file: str | Path, spring: str | Path | None = None, *, out_dir:
     >>> found.calibration["k_fitted_Nm_per_rad"]
     """
     file = Path(file)
+    if law not in ("auto", "scale", *FAMILIES):
+        raise ConfigError(f"law = '{law}': use auto, scale, {', '.join(FAMILIES)}")
     spring_doc, declared, exclude = None, [], ()
     if measured or predicted:
         if not (measured and predicted):
@@ -207,6 +216,8 @@ def explain_file(file: str | Path, spring: str | Path | None = None, *, out_dir:
         spring_doc = load_spring(spring)
         if _kind(file) == "bench":
             data = bench_loop_data(read_bench(file), spring_doc, predict)
+            if law != "scale" and predict == "torque" and "torque_curve" in spring_doc:
+                bench_shapes(spring_doc, data, tuple(FAMILIES) if law == "auto" else (law,))
             loop_plot, stem = True, file.stem
         else:
             raw = read_recording(file)

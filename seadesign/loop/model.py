@@ -68,6 +68,8 @@ class Fit:
     extra: dict = field(default_factory=dict)
     correlation: dict[tuple[str, str], dict[tuple[str, str], float]] = field(default_factory=dict)
     # (term, parameter) -> the other fitted parameters it is correlated with at |r| >= CORRELATED, and r
+    covariance: dict[tuple[tuple[str, str], tuple[str, str]], float] = field(default_factory=dict)
+    # ((term, parameter), (term, parameter)) -> covariance of the two estimates, over the fitted parameters
 
     @property
     def keys(self) -> tuple[str, ...]:
@@ -200,6 +202,7 @@ class EffectModel:
         ssr = float(np.sum((data.measured[train] - pred[train]) ** 2))
         sigma = np.zeros(len(names))
         correlation: dict = {}
+        covariance: dict = {}
         if best is not None:
             with np.errstate(over="ignore", divide="ignore"):
                 jac = best.jac * np.where(logs[free], 1.0 / x_best[free], 1.0)  # d/dx = d/du / x for log parameters
@@ -209,7 +212,9 @@ class EffectModel:
                 meat = _hac(jac * (data.measured[rows] - pred[rows])[:, None], -(-data.window // spacing))
                 cov = bread @ meat @ bread * (rows.size / max(n - int(free.sum()), 1))
                 sigma[free] = np.sqrt(np.clip(np.diag(cov), 0, None))
-                correlation = _correlated(cov, [n for n, f in zip(names, free) if f])
+                fitted = [n for n, f in zip(names, free) if f]
+                correlation = _correlated(cov, fitted)
+                covariance = {(a, b): float(cov[i, j]) for i, a in enumerate(fitted) for j, b in enumerate(fitted)}
             except np.linalg.LinAlgError:
                 sigma[free] = np.nan
         held_dt = [(t, p) for (t, p), f in zip(names, free) if not f and p == "time_s"]
@@ -223,7 +228,7 @@ class EffectModel:
             bounds[t][p] = (float(a), float(b))
         self.fit_ = Fit(list(self.terms), values, self._values(names, sigma), by_term, bounds, pred,
                         split_metrics(data.measured, pred, held, data.in_range), float(ll + 2 * p_count),
-                        float(ll + p_count * np.log(n)), n, converged, correlation=correlation)
+                        float(ll + p_count * np.log(n)), n, converged, correlation=correlation, covariance=covariance)
         return self
 
     def predict(self, data: LoopData) -> np.ndarray:

@@ -18,18 +18,22 @@ one (`SpringCurve`, PCHIP): the model's spring either way, its stiffness scale a
 from __future__ import annotations
 
 import hashlib
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from seadesign.data import knee_channels
-from seadesign.design.materials import Material, load_material
+from seadesign.design.materials import Hyperelastic, Material, load_material
 from seadesign.errors import ConfigError
 from seadesign.design.spring import torque_curve
 from seadesign.effects import DeadBand, Effect, Friction, spring_law
-from seadesign.loop.engine import Explanation
+from seadesign.loop.engine import SCALE, Explanation
+from seadesign.loop.model import Fit
 from seadesign.loop.table import LoopData, LoopInputError, smooth_rate
+from seadesign.loop.terms import LAW_SHAPES
 from seadesign.twin.config import GEAR_COULOMB_NM
 
 #: the robot model's declared effects: library key -> name in the model
@@ -88,28 +92,60 @@ def robot_loop_data(df: pd.DataFrame, spring: dict[str, Any], knee: str = "l") -
 
 
 #: what the fitted law is, said with every calibration
-LAW_NOTE = ("an effective isotropic law of a printed part, which is anisotropic (layers, infill): one factor on "
-            "every modulus of the material's law, fitted to the spring's torque against its rotation")
+LAW_NOTE = ("an effective isotropic law of a printed part, which is anisotropic (layers, infill), fitted to the "
+            "spring's torque against its rotation: it reproduces this part's curve, not a coupon's tensile test")
+_MODULI = ("c10_Pa", "c01_Pa", "c20_Pa", "c30_Pa")
 
 
-def fitted_law(material: Material, spring_modulus_Pa: float, scale: float, scale_uncertainty: float) -> dict[str, Any]:
-    """The material's finite-strain law with every modulus (and 1 / compressibility) times the fitted stiffness
-    scale, relative to the modulus the spring was computed with: parameters (Pa, 1/Pa) with uncertainties and
-    the initial shear modulus mu = 2 (C10 + C01). Exact for a torque curve: a hyperelastic law's stresses scale
-    with its moduli when its compressibilities scale inversely, so the path's torque scales and its shape stays."""
-    factor = spring_modulus_Pa * scale / material.youngs_modulus_Pa
-    fitted = material.scaled(factor, "fitted")
-    law = fitted.law
-    relative = scale_uncertainty / scale
-    out: dict[str, Any] = {"model": law.model, "factor_on_material_file": factor}
-    for name in ("c10_Pa", "c01_Pa", "c20_Pa", "c30_Pa"):
-        if getattr(law, name):
-            out[name], out[name.replace("_Pa", "_uncertainty_Pa")] = getattr(law, name), getattr(law, name) * relative
-    out |= {name: getattr(law, name) for name in ("d1_per_Pa", "d2_per_Pa", "d3_per_Pa") if getattr(law, name)}
-    out["mu_Pa"] = law.shear_modulus_Pa
-    out["mu_uncertainty_Pa"] = out["mu_Pa"] * relative
-    out["youngs_modulus_Pa"] = fitted.youngs_modulus_Pa  # the linear solve's, following mu
-    out["fitted"] = ["one factor on every modulus (the curve's scale)"]
+def fitted_law(material: Material, spring_modulus_Pa: float, fit: Fit) -> dict[str, Any]:
+    """The material's finite-strain law fitted by the loop: every modulus (and 1 / compressibility) times the
+    curve's stiffness scale relative to the modulus the spring was computed with, the law's shape from the fitted
+    law-shape term when there is one (`loop.law_family`: Mooney-Rivlin's C01 share, Yeoh's C20 / C10, at the
+    material's initial shear modulus). Parameters in Pa (1/Pa) with uncertainties and the correlation of the two
+    fitted moduli (propagated from the fit's covariance), the initial shear modulus mu = 2 (C10 + C01) and the linear
+    solve's Young's modulus that follows it. Exact for a torque curve: a hyperelastic law's stresses scale with its
+    moduli when its compressibilities scale inversely, so the path's torque scales and its shape stays."""
+    values = fit.parameters()
+    scale = values.get(SCALE, {}).get("scale", {"value": 1.0, "uncertainty": 0.0})["value"]
+    a = spring_modulus_Pa / material.youngs_modulus_Pa
+    shape = next((t for t in fit.terms if t.key in LAW_SHAPES), None)
+    fitted: list[tuple[tuple[str, str], float]] = [((SCALE, "scale"), scale)]
+    if shape is None:
+        def law_at(s: float, v: float) -> Hyperelastic:
+            return material.scaled(a * s, "fitted").law
+    else:
+        param = shape.effect.parameters[0].name
+        fitted.append(((shape.name, param), values[shape.name][param]["value"]))
+
+        def law_at(s: float, v: float) -> Hyperelastic:
+            return replace(material, hyperelastic=shape.effect.family.law(v)).scaled(a * s, "fitted").law
+    x = np.array([v for _, v in fitted])
+    cov = np.array([[fit.covariance.get((p, q), 0.0) for q, _ in fitted] for p, _ in fitted])
+    if shape is None:
+        x = np.append(x, 0.0)
+        cov = np.pad(cov, ((0, 1), (0, 1)))
+    law = law_at(*x)
+    names = [n for n in _MODULI if getattr(law, n)] + ["mu_Pa"]
+
+    def moduli(s: float, v: float) -> np.ndarray:
+        m = law_at(s, v)
+        return np.array([getattr(m, n) for n in names[:-1]] + [m.shear_modulus_Pa])
+
+    jac = np.column_stack([(moduli(*(x + h)) - moduli(*(x - h))) / (2 * h[i])  # the moduli are linear in s and v
+                           for i, h in enumerate(np.diag([1e-6 * max(abs(x[0]), 1.0), 1e-6]))])
+    spread = jac @ cov @ jac.T
+    sd = np.sqrt(np.clip(np.diag(spread), 0.0, None))
+    out: dict[str, Any] = {"model": law.model, "factor_on_material_file": a * scale}
+    for i, n in enumerate(names):
+        out[n] = float(moduli(*x)[i])
+        out[n.replace("_Pa", "_uncertainty_Pa")] = float(sd[i])
+    out |= {n: getattr(law, n) for n in ("d1_per_Pa", "d2_per_Pa", "d3_per_Pa") if getattr(law, n)}
+    if len(names) > 2:
+        out[f"correlation_{names[0][:-3]}_{names[1][:-3]}"] = float(spread[0, 1] / max(sd[0] * sd[1], 1e-300))
+    out["youngs_modulus_Pa"] = law_at(*x).shear_modulus_Pa * 2.0 * (1.0 + material.poisson_ratio)
+    out["fitted"] = ["the curve's scale (one factor on every modulus)"] + \
+        ([f"the law's shape, {shape.key} {shape.effect.parameters[0].name} = {fitted[1][1]:.4g} "
+          f"({shape.effect.parameters[0].doc})"] if shape is not None else [])
     out["note"] = LAW_NOTE
     return out
 
@@ -152,7 +188,6 @@ def calibration(ex: Explanation, spring: dict[str, Any], source: Path,
                 found = None
         if found is not None:
             out["material"] = found.key
-            out["law"] = fitted_law(found, float(spring["material"]["youngs_modulus_Pa"]), scale["value"],
-                                    scale["uncertainty"])
+            out["law"] = fitted_law(found, float(spring["material"]["youngs_modulus_Pa"]), ex.final)
     return out
 

@@ -85,6 +85,8 @@ class LoopData:
     units: dict[str, str] = field(default_factory=dict)
     columns: dict[str, str] = field(default_factory=dict)
     gain: float | None = None
+    shapes: dict[str, Effect] = field(default_factory=dict)  # law-shape candidates (`terms.LAW_SHAPES`) by key
+    notes: list[str] = field(default_factory=list)  # what the verdict must also say about the data (coverage)
     in_range: np.ndarray = field(init=False, repr=False)  # samples the model covers (the fit and its errors use these)
     coverage: "CurveCoverage | None" = field(init=False, default=None)  # where the data leave the torque curve
 

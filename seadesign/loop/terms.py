@@ -8,7 +8,8 @@ effect's, with the effect's names and units. `PLACES` says where an effect acts:
 - `effort` (compliance direction with an effort signal): the servo's effort is undone into the
   spring torque: its lag (`EffortLag.torque_from_effort`) and the gear friction on the motor side;
 - `deflection`: dead-band or backlash (`DeadBand`; in the compliance direction its free travel);
-- `spring`: the spring law: `stiffness_scale` (the declared k, always refitted), cubic stiffening,
+- `spring`: the spring law: `stiffness_scale` (the declared k, always refitted), the law's shape on a bench with a
+  torque curve (`mooney_rivlin`, `yeoh`: the curve of the spring's own part under that law, `loop.law_family`), cubic stiffening,
   hysteresis, viscoelasticity (torque terms; in the compliance direction inverted: a Newton solve of
   the cubic, the inverse of the standard-linear-solid filter, the Dahl loop sharing the torque with k), thermal and
   temperature softening (factors; thermal in the compliance direction marched in time);
@@ -42,18 +43,20 @@ from seadesign.loop.table import LoopData
 PLACES: dict[str, str] = {
     "sensor_delay": "sensor", "sensor_offset": "sensor", "sensor_step": "sensor", "sensor_drift": "sensor",
     "effort_lag": "effort", "friction": "load", "dead_band": "deflection",
-    "stiffness_scale": "spring", "cubic_stiffening": "spring", "hysteresis": "spring", "viscoelastic": "spring",
+    "stiffness_scale": "spring", "mooney_rivlin": "spring", "yeoh": "spring", "cubic_stiffening": "spring", "hysteresis": "spring", "viscoelastic": "spring",
     "thermal_softening": "spring", "temperature_softening": "spring", "gravity": "load",
 }
 #: order of the effects within the model (the simulator's order in its chain)
-ORDER = ("effort_lag", "friction", "dead_band", "stiffness_scale", "cubic_stiffening", "hysteresis", "viscoelastic",
+ORDER = ("effort_lag", "friction", "dead_band", "stiffness_scale", "mooney_rivlin", "yeoh", "cubic_stiffening", "hysteresis", "viscoelastic",
          "thermal_softening", "temperature_softening", "gravity", "sensor_delay", "sensor_offset", "sensor_step",
          "sensor_drift")
 #: loop candidates that are a library effect on a bench's torque channel: name -> (library key, binding)
 TORQUE_CHANNEL = {"torque_delay": ("sensor_delay", {"hall": "torque"}), "torque_lag": ("effort_lag", {"effort": "torque"})}
 #: effects the loop can trace as candidates (library keys, and the torque-channel names); the spring itself is
 #: declared, not traced
-CANDIDATES = tuple(k for k in ORDER if k != "stiffness_scale") + tuple(TORQUE_CHANNEL)
+#: loop candidates that are the spring law's shape (`LoopData.shapes`: only where the spring's part is known)
+LAW_SHAPES = ("mooney_rivlin", "yeoh")
+CANDIDATES = tuple(k for k in ORDER if k != "stiffness_scale" and k not in LAW_SHAPES) + tuple(TORQUE_CHANNEL)
 #: effects whose value at a sample needs the whole record (history or neighbours: the smoothed friction, the
 #: sensor effects undone before smoothing); a model without them is evaluated on the fitted rows alone
 WHOLE_RECORD = frozenset({"hysteresis", "viscoelastic", "thermal_softening", "sensor_delay"})
@@ -116,6 +119,7 @@ def applicable(key: str, data: LoopData) -> bool:
         "temperature_softening": "temperature" in s,
         "stiffness_scale": data.spring is not None or np.ptp(data.predicted) > 0,
         **dict.fromkeys(TORQUE_CHANNEL, not comp and data.sensor_on == "deflection" and data.spring is not None),
+        **{k: not comp and k in data.shapes for k in LAW_SHAPES},
     }
     spring_terms = ("dead_band", "cubic_stiffening", "hysteresis", "viscoelastic", "thermal_softening")
     if key in spring_terms:
@@ -191,10 +195,13 @@ def _torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
     stateful = {"hysteresis", "viscoelastic", "thermal_softening"} & {t.key for t in at["spring"]}
     ds = None if not stateful else d if spring else data.smoothed(d) if d is not d0 else data.smooth("deflection")
     tau, factor = path, 1.0
+    scale = next((values[t.name]["scale"] for t in at["spring"] if t.key == "stiffness_scale"), 1.0)
     for t in at["spring"]:
         p = values[t.name]
         if t.key == "stiffness_scale":
             tau = tau * p["scale"]
+        elif t.key in LAW_SHAPES:
+            tau = tau + scale * t.effect.shape_torque(d, p[t.effect.parameters[0].name])
         elif t.key == "cubic_stiffening":
             tau = tau + p["k3_Nm_per_rad3"] * d ** 3
         elif t.key == "hysteresis":

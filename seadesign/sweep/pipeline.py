@@ -9,10 +9,11 @@ otherwise SI (N, Nm, rad, Pa).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from seadesign.design.materials import Hyperelastic
 from seadesign.design.study import DEFAULT_STUDY, Study, load_study
 from seadesign.errors import ConfigError
 from seadesign.run.cache import default_cache
@@ -100,12 +101,29 @@ def _calibrated_law(study: Study, path: Path, data: dict) -> tuple[Study, str]:
     if not isinstance(law, dict):
         raise ConfigError(f"--calibration {path}: 'law' must be a table of the fitted parameters")
     mu = _positive(path, "law/mu_Pa", law.get("mu_Pa"))
-    if law.get("model") != material.law.model:
-        raise ConfigError(f"--calibration {path}: law/model '{law.get('model')}' was fitted, but material '{name}' "
-                          f"has a {material.law.model} law now; explain the bench file again")
     scale = mu / material.law.shear_modulus_Pa
     note = f"calibrated from {path.name}: mu = {mu:.4g} Pa, x {scale:.4g} on every modulus of '{name}'"
-    return study.with_materials({name: material.scaled(scale, note)}), note
+    calibrated = material.scaled(scale, note)
+    model = law.get("model")
+    if model != material.law.model:  # a law of another family (the shape fitted too): its own parameters
+        needed = {"mooney_rivlin": ("c10_Pa", "c01_Pa", "d1_per_Pa"), "yeoh": ("c10_Pa", "c20_Pa", "d1_per_Pa"),
+                  "neo_hooke": ("c10_Pa", "d1_per_Pa")}.get(model)
+        if needed is None:
+            raise ConfigError(f"--calibration {path}: law/model '{model}' is unknown; use neo_hooke, mooney_rivlin "
+                              f"or yeoh")
+        missing = [k for k in needed if not isinstance(law.get(k), (int, float))]
+        if missing:
+            raise ConfigError(f"--calibration {path}: law/model '{model}' was fitted, but 'law' lacks "
+                              f"{', '.join(missing)}; explain the bench file again")
+        fields = {k: float(law[k]) for k in ("c10_Pa", "c01_Pa", "c20_Pa", "c30_Pa", "d1_per_Pa", "d2_per_Pa",
+                                             "d3_per_Pa") if k in law}
+        fitted = Hyperelastic(model, source=note, **fields)
+        if abs(fitted.shear_modulus_Pa / mu - 1.0) > 1e-9:
+            raise ConfigError(f"--calibration {path}: law/mu_Pa {mu:.6g} is not 2 (C10 + C01) = "
+                              f"{fitted.shear_modulus_Pa:.6g} Pa of its own parameters")
+        calibrated = replace(calibrated, hyperelastic=fitted)
+        note += f" ({model} law: {', '.join(f'{k} {v:.4g}' for k, v in fields.items())})"
+    return study.with_materials({name: calibrated}), note
 
 
 @dataclass
