@@ -146,6 +146,8 @@ class Explanation:
         if self.data.coverage is not None:
             text += " " + self.data.coverage.text()
         text += "".join(" " + note for note in self.data.notes)
+        if any(k in self.data.shapes for k in LAW_SHAPES):
+            text += " " + self.law_shape_text()
         if not self.final.converged:
             text += " The final fit did not converge (evaluation limit): its numbers are not a result."
         s = self.tests_after["strongest"]
@@ -156,6 +158,28 @@ class Explanation:
                      f"{s['signal']} at lag {s['lag_s']:.3g} s (correlation {s['correlation']:.3g}, "
                      f"binned share of variance {s['explained_share_binned']:.3g}).")
         return text
+
+
+    def law_shape_text(self) -> str:
+        """Which law shape the held-out error prefers, or that the data cannot tell the shapes apart."""
+        named = next((t.key for t in self.final.terms if t.key in LAW_SHAPES), None)
+        if named is None:
+            tried = [t for t in self.last_trace if t.effect in LAW_SHAPES]
+            best = min(tried, key=lambda t: t.held_out_rmse, default=None)
+            scores = f" (best: {best.effect}, held-out RMSE {best.held_out_rmse:.4g} against {self.final.errors['held_out']['rmse']:.4g})" \
+                if best is not None else ""
+            return (f"No law shape beats the material's own on held-out data{scores}: over this file's strains the "
+                    f"Mooney-Rivlin and Yeoh shapes and the material's law are indistinguishable, so the shape is not "
+                    f"identified and mu's uncertainty in the calibration includes the shape-free fit's.")
+        step = next(s for s in self.steps if s.effect == named)
+        ours = next(t.held_out_rmse for t in step.trace if t.effect == named)
+        if step.alternative is not None and step.alternative.effect in LAW_SHAPES:
+            return (f"The data cannot tell the {named} and {step.alternative.effect} shapes apart over this file's "
+                    f"strains (held-out RMSE {ours:.4g} and {step.alternative.held_out_rmse:.4g}); the fitted law is "
+                    f"the {named} one.")
+        other = [t for t in step.trace if t.effect in LAW_SHAPES and t.effect != named]
+        against = f" over {other[0].effect} ({other[0].held_out_rmse:.4g})" if other else ""
+        return f"The held-out error prefers the {named} shape (held-out RMSE {ours:.4g}){against}."
 
 
 def _term(key: str, data: LoopData, current: Fit) -> Term | None:

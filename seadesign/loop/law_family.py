@@ -29,14 +29,14 @@ from seadesign.design.study import Study, load_study
 from seadesign.effects.base import Effect, Param
 from seadesign.errors import ConfigError
 from seadesign.loop.table import LoopData, LoopInputError
-from seadesign.run.cache import Cache
+from seadesign.run.executors import default_jobs, run_processes, run_serial
 from seadesign.sweep.handoff import curve_to_stop
 from seadesign.sweep.single import CandidatePath, candidate_path
 
 #: the law families a bench curve is fitted with: model -> (shape parameter, its nodes, what it is)
 FAMILIES: dict[str, tuple[str, tuple[float, ...], str]] = {
     "mooney_rivlin": ("c01_share", (0.0, 0.4, 0.8), "C01 / (C10 + C01), at the material's mu = 2 (C10 + C01)"),
-    "yeoh": ("c20_ratio", (-0.15, 0.0, 0.15), "C20 / C10, at the material's mu = 2 C10"),
+    "yeoh": ("c20_ratio", (-0.1, 0.0, 0.1), "C20 / C10, at the material's mu = 2 C10"),
 }
 #: the peak tensile strain below which a bench curve does not tell the laws' shapes apart (the second parameter acts
 #: through the strain's square and beyond; about 20 % in the part's most strained fillet)
@@ -80,10 +80,10 @@ class SpringSource:
     candidate: Candidate
     path: CandidatePath
 
-    def with_law(self, law: Hyperelastic, cache: Cache | None = None) -> CandidatePath:
+    def with_law(self, law: Hyperelastic) -> CandidatePath:
         """The candidate's path with the material's law replaced by `law` (from the stage cache when there)."""
         material: Material = replace(self.candidate.material, hyperelastic=law)
-        return candidate_path(self.study, replace(self.candidate, material=material), cache=cache)
+        return candidate_path(self.study, replace(self.candidate, material=material))
 
 
 def _candidate(study: Study, spring: dict[str, Any]) -> Candidate:
@@ -109,7 +109,7 @@ def path_curve(path: CandidatePath) -> TorqueCurve:
     return TorqueCurve(tuple(rotation), tuple(torque), stop_reason=r.stop_reason)
 
 
-def spring_source(spring: dict[str, Any], cache: Cache | None = None) -> SpringSource:
+def spring_source(spring: dict[str, Any]) -> SpringSource:
     """The study and candidate of spring.json, checked: its candidate under the material's law must give
     spring.json's torque curve. SpringSourceError with the reason otherwise (no curve, study not found, candidate
     not in the study, the curve changed)."""
@@ -129,7 +129,7 @@ def spring_source(spring: dict[str, Any], cache: Cache | None = None) -> SpringS
     except (ConfigError, KeyError) as exc:
         raise SpringSourceError(f"spring.json's design is not a candidate of study '{name}' ({exc}): the study changed "
                                 f"since the sweep; rerun `seadesign sweep {name}`") from None
-    path = candidate_path(study, candidate, cache=cache)
+    path = candidate_path(study, candidate)
     now = path_curve(path)
     end = max(abs(curve.torque_Nm[-1]), 1e-12)
     if len(now.torque_Nm) != len(curve.torque_Nm) or \
@@ -188,17 +188,35 @@ class LawFamily:
         return float(np.interp(abs(rotation_rad), self.strain_rotation_rad, self.strain))
 
 
-def law_family(source: SpringSource, model: str, cache: Cache | None = None) -> LawFamily:
-    """The family `model` (`FAMILIES`) of the spring of `source`: one path per node (the material's own law is the
-    node at its shape value)."""
-    parameter, nodes, _ = FAMILIES[model]
+def _trial_curve(task: tuple[Study, Candidate], sink) -> TorqueCurve:
+    """A worker's task: the path's curve of a candidate whose material carries a trial law."""
+    study, candidate = task
+    return path_curve(candidate_path(study, candidate))
+
+
+def law_families(source: SpringSource, models: tuple[str, ...]) -> dict[str, LawFamily]:
+    """The families `models` (`FAMILIES`) of the spring of `source`: one path per node (the material's own law is
+    the node at its shape value; the others in worker processes, two at a time on two cores, from the stage cache
+    when there)."""
     base = source.candidate.material.law
-    b = base_value(base, model)
-    nodes = tuple(sorted({*nodes, b}, key=float)) if b not in nodes else nodes
-    curves = tuple(path_curve(source.path) if v == b else path_curve(source.with_law(trial_law(base, model, v), cache))
-                   for v in nodes)
+    nodes = {}
+    for model in models:
+        b = base_value(base, model)
+        nodes[model] = (b, tuple(sorted({*FAMILIES[model][1], b})))
+    trials = [(m, v) for m, (b, vs) in nodes.items() for v in vs if v != b]
+    tasks = [(source.study, replace(source.candidate, material=replace(source.candidate.material,
+                                                                       hyperelastic=trial_law(base, m, v))))
+             for m, v in trials]
+    jobs = min(default_jobs(), len(tasks))
+    run = run_serial(_trial_curve, tasks, lambda *_: None, lambda: None) if jobs <= 1 else \
+        run_processes(_trial_curve, tasks, jobs, lambda *_: None, lambda: None, [])
+    by_task = {id(task): curve for task, curve in run}
+    curves = {trial: by_task[id(task)] for trial, task in zip(trials, tasks)}
+    own = path_curve(source.path)
     r = source.path.result
-    return LawFamily(model, parameter, base, b, nodes, curves, r.curve_rotation_rad, r.curve_tensile_strain)
+    return {m: LawFamily(m, FAMILIES[m][0], base, b, vs, tuple(own if v == b else curves[(m, v)] for v in vs),
+                         r.curve_rotation_rad, r.curve_tensile_strain)
+            for m, (b, vs) in nodes.items()}
 
 
 class LawShape(Effect):
@@ -254,16 +272,14 @@ def shape_coverage(family: LawFamily, data: LoopData) -> str:
     strain = family.strain_at(reach)
     enough = strain >= SHAPE_STRAIN
     return (f"The bench file reaches {reach:.4g} rad on the curve, where the part's peak tensile strain is "
-            f"{strain:.1%}: {'enough' if enough else 'not enough'} to tell the law's shape (Mooney-Rivlin's C01 share, "
-            f"Yeoh's C20) from its scale, which needs strains past about {SHAPE_STRAIN:.0%}"
-            + ("." if enough else "; the shape is not identified by this file (a test to larger deflections is)."))
+            f"{strain:.1%}; the law's shape (Mooney-Rivlin's C01 share, Yeoh's C20) shows in a torque curve only past "
+            f"about {SHAPE_STRAIN:.0%}" + ("." if enough else ", which this file does not reach: it cannot identify "
+                                        "the shape (a test to larger deflections can)."))
 
 
-def bench_shapes(spring: dict[str, Any], data: LoopData, models: tuple[str, ...] = tuple(FAMILIES),
-                 cache: Cache | None = None) -> None:
+def bench_shapes(spring: dict[str, Any], data: LoopData, models: tuple[str, ...] = tuple(FAMILIES)) -> None:
     """Give a bench `data` (torque from deflection, with spring.json's torque curve) the law-shape candidates
-    `models` of the spring's own part (`spring_source`, `law_family`) and the note on what the file covers."""
-    source = spring_source(spring, cache)
-    families = {m: law_family(source, m, cache) for m in models}
+    `models` of the spring's own part (`spring_source`, `law_families`) and the note on what the file covers."""
+    families = law_families(spring_source(spring), models)
     data.shapes.update({m: SHAPES[m](f) for m, f in families.items()})
     data.notes.append(shape_coverage(next(iter(families.values())), data))

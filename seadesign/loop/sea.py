@@ -30,7 +30,7 @@ from seadesign.design.materials import Hyperelastic, Material, load_material
 from seadesign.errors import ConfigError
 from seadesign.design.spring import torque_curve
 from seadesign.effects import DeadBand, Effect, Friction, spring_law
-from seadesign.loop.engine import SCALE, Explanation
+from seadesign.loop.engine import SCALE, Explanation, TraceEntry
 from seadesign.loop.model import Fit
 from seadesign.loop.table import LoopData, LoopInputError, smooth_rate
 from seadesign.loop.terms import LAW_SHAPES
@@ -150,6 +150,14 @@ def fitted_law(material: Material, spring_modulus_Pa: float, fit: Fit) -> dict[s
     return out
 
 
+def unsupported_shape(ex: Explanation) -> TraceEntry | None:
+    """The best law-shape fit of the loop's last round when no shape was named (None: a shape was named, or none
+    was traced)."""
+    if any(t.key in LAW_SHAPES for t in ex.final.terms):
+        return None
+    return min((t for t in ex.last_trace if t.effect in LAW_SHAPES), key=lambda t: t.held_out_rmse, default=None)
+
+
 def calibration(ex: Explanation, spring: dict[str, Any], source: Path,
                 material: Material | None = None) -> dict[str, Any]:
     """The calibration JSON for `seadesign sweep --calibration`: `stiffness_scale` (fitted k / model k; the
@@ -188,6 +196,19 @@ def calibration(ex: Explanation, spring: dict[str, Any], source: Path,
                 found = None
         if found is not None:
             out["material"] = found.key
-            out["law"] = fitted_law(found, float(spring["material"]["youngs_modulus_Pa"]), ex.final)
+            modulus = float(spring["material"]["youngs_modulus_Pa"])
+            out["law"] = fitted_law(found, modulus, ex.final)
+            free = unsupported_shape(ex)
+            if free is not None:  # a shape the data cannot rule out widens what the modulus is known to
+                shaped = fitted_law(found, modulus, free.fit)
+                spread = abs(shaped["mu_Pa"] - out["law"]["mu_Pa"])
+                out["law"]["mu_uncertainty_Pa"] = float(np.hypot(out["law"]["mu_uncertainty_Pa"], spread))
+                gain = 1.0 - free.held_out_rmse / ex.final.errors["held_out"]["rmse"]
+                out["law"]["shape_unsupported"] = {**{k: shaped[k] for k in shaped if k not in ("note", "fitted")},
+                                                   "held_out_gain": gain, "fitted": shaped["fitted"]}
+                out["law"]["fitted"].append(
+                    f"the law's shape is not supported by the data (held-out gain {gain:.1%} with {free.effect}); "
+                    f"with it free mu = {shaped['mu_Pa']:.4g} +- {shaped['mu_uncertainty_Pa']:.2g} Pa, so mu's "
+                    f"uncertainty includes the difference, {spread:.2g} Pa")
     return out
 
