@@ -19,6 +19,130 @@ import pytest
 from seadesign.design.materials import Hyperelastic
 
 STUDY = "law_bench"
+NODES = (0.0, 0.4, 0.8)  # Mooney-Rivlin's C01 share
+
+
+def shaped_torque(theta, share: float = 0.0):
+    """A closed-form family of spring curves (Nm): softening like the default study's paths, the shape parameter
+    softening less (linear in it: quadratic interpolation over three nodes is exact; not a cubic term, which the
+    library's cubic stiffening would be as well)."""
+    return 30.0 * theta * (1.0 - (0.8 - 0.6 * share) * np.abs(theta))
+
+
+def synthetic_family():
+    """A `LawFamily` of the closed form at the nodes, 31 points to 0.3 rad each (no paths computed)."""
+    from seadesign.design.materials import load_material
+    from seadesign.design.spring import TorqueCurve
+    from seadesign.loop.law_family import LawFamily
+
+    theta = np.linspace(0.0, 0.3, 31)
+    curves = tuple(TorqueCurve(tuple(theta), tuple(shaped_torque(theta, v))) for v in NODES)
+    return LawFamily("mooney_rivlin", "c01_share", load_material("ninjaflex").law, 0.0, NODES, curves,
+                     (0.0, 0.3), (0.0, 0.6))
+
+
+def test_trial_laws_keep_the_initial_shear_modulus_and_compressibility():
+    from seadesign.design.materials import load_material
+    from seadesign.loop.law_family import SpringSourceError, base_value, trial_law
+
+    base = load_material("ninjaflex").law
+    mr, yeoh = trial_law(base, "mooney_rivlin", 0.3), trial_law(base, "yeoh", -0.05)
+    for law in (mr, yeoh):
+        assert law.shear_modulus_Pa == pytest.approx(base.shear_modulus_Pa, rel=1e-14)
+        assert law.d1_per_Pa == base.d1_per_Pa
+    assert mr.c01_Pa / (mr.c10_Pa + mr.c01_Pa) == pytest.approx(0.3) and base_value(mr, "mooney_rivlin") == pytest.approx(0.3)
+    assert yeoh.c20_Pa / yeoh.c10_Pa == pytest.approx(-0.05) and base_value(base, "yeoh") == 0.0
+    with pytest.raises(SpringSourceError, match="starts from a neo-Hookean law or a yeoh one"):
+        trial_law(mr, "yeoh", 0.1)
+
+
+def test_the_family_interpolates_its_nodes_exactly_and_is_odd():
+    family = synthetic_family()
+    theta = np.linspace(-0.3, 0.3, 41)
+    for v in (0.0, 0.25, 0.4, 0.7):  # exact for a family linear in the parameter (up to the curves' PCHIP)
+        np.testing.assert_allclose(family.torque(theta, v), shaped_torque(theta, v), atol=2e-3)
+    np.testing.assert_allclose(family.torque(-theta, 0.3), -family.torque(theta, 0.3), rtol=0, atol=1e-15)
+    assert family.weights(0.4) == pytest.approx([0.0, 1.0, 0.0], abs=1e-15)
+    assert family.torque(np.array([0.5]), 0.0)[0] == pytest.approx(shaped_torque(0.3), rel=1e-12)  # held at the end
+
+
+def test_the_loop_names_the_law_shape_and_recovers_it_with_the_scale(spring_dict):
+    """A bench part at 0.6 of the curve's scale with share 0.5: the loop names the shape and both come back within
+    three reported uncertainties; the calibration's C10 and C01 follow with the covariance propagated (checked
+    against the hand-derived variance of C10 = a s (1 - v) mu / 2)."""
+    from helpers_generators import bench_curve
+
+    from seadesign.design.materials import load_material
+    from seadesign.loop import explain
+    from seadesign.loop.law_family import MooneyRivlinShape
+    from seadesign.loop.sea import bench_loop_data, fitted_law
+
+    family = synthetic_family()
+    curve = {"rotation_rad": list(family.curves[0].rotation_rad), "torque_Nm": list(family.curves[0].torque_Nm),
+             "source": "fea_large_deflection", "stop_reason": "bifurcation", "hard_stop": False}
+    df = bench_curve(lambda d: shaped_torque(d, 0.5), 0.6, amplitude_rad=0.28, seed=3, duration_s=120.0)
+    data = bench_loop_data(df, {**spring_dict, "torque_curve": curve})
+    data.shapes["mooney_rivlin"] = MooneyRivlinShape(family)
+    ex = explain(data, [])
+    assert "mooney_rivlin" in ex.found, ex.verdict()
+    p = ex.final.parameters()
+    for term, name, true in (("stiffness_scale", "scale", 0.6), ("mooney_rivlin", "c01_share", 0.5)):
+        assert abs(p[term][name]["value"] - true) <= 3 * p[term][name]["uncertainty"], (name, p[term][name])
+    material = load_material("ninjaflex")
+    law = fitted_law(material, material.youngs_modulus_Pa, ex.final)
+    s, v = p["stiffness_scale"]["scale"]["value"], p["mooney_rivlin"]["c01_share"]["value"]
+    half_mu = material.law.shear_modulus_Pa / 2
+    assert (law["c10_Pa"], law["c01_Pa"]) == pytest.approx((s * (1 - v) * half_mu, s * v * half_mu), rel=1e-12)
+    cov = ex.final.covariance
+    ss, vv = ("stiffness_scale", "scale"), ("mooney_rivlin", "c01_share")
+    var_c10 = half_mu ** 2 * ((1 - v) ** 2 * cov[ss, ss] + s ** 2 * cov[vv, vv] - 2 * s * (1 - v) * cov[ss, vv])
+    assert law["c10_uncertainty_Pa"] == pytest.approx(np.sqrt(var_c10), rel=1e-6)
+    assert law["mu_uncertainty_Pa"] == pytest.approx(2 * half_mu * np.sqrt(cov[ss, ss]), rel=1e-6)
+    assert "The held-out error prefers the mooney_rivlin shape" in ex.verdict() or "shapes apart" in ex.verdict()
+
+
+def test_the_loop_names_no_shape_on_the_materials_own_curve(spring_dict):
+    from helpers_generators import bench_curve
+
+    from seadesign.loop import explain
+    from seadesign.loop.law_family import MooneyRivlinShape
+    from seadesign.loop.sea import bench_loop_data
+
+    family = synthetic_family()
+    curve = {"rotation_rad": list(family.curves[0].rotation_rad), "torque_Nm": list(family.curves[0].torque_Nm),
+             "source": "fea_large_deflection", "stop_reason": "bifurcation", "hard_stop": False}
+    data = bench_loop_data(bench_curve(shaped_torque, 0.6, amplitude_rad=0.28, seed=4, duration_s=120.0),
+                           {**spring_dict, "torque_curve": curve})
+    data.shapes["mooney_rivlin"] = MooneyRivlinShape(family)
+    ex = explain(data, [])
+    assert ex.found == ["stiffness_scale"], ex.verdict()
+    assert "No law shape beats the material's own on held-out data" in ex.verdict()
+
+
+def test_a_spring_whose_study_is_missing_is_refused_for_the_law_and_fitted_for_the_scale(spring_dict, tmp_path):
+    """`explain --law auto` needs the spring's own part; `--law scale` does not."""
+    from helpers_generators import bench_curve
+
+    from seadesign.design.spring import write_spring
+    from seadesign.loop.explain_file import explain_file
+    from seadesign.loop.law_family import SpringSourceError
+
+    theta = np.linspace(0.0, 0.3, 16)
+    curve = {"rotation_rad": theta.tolist(), "torque_Nm": shaped_torque(theta).tolist(),
+             "source": "fea_large_deflection", "stop_reason": "bifurcation", "hard_stop": False}
+    spring = write_spring({**spring_dict, "schema_version": 2, "study": "no_such_study", "torque_curve": curve},
+                          tmp_path / "spring.json")
+    bench_curve(shaped_torque, 0.5, amplitude_rad=0.28, seed=5).to_csv(tmp_path / "bench.csv", index=False)
+    with pytest.raises(SpringSourceError, match="spring.json's study 'no_such_study' cannot be loaded .*--law scale"):
+        explain_file(tmp_path / "bench.csv", spring, out_dir=tmp_path / "o")
+    found = explain_file(tmp_path / "bench.csv", spring, out_dir=tmp_path / "o", law="scale")
+    assert found.calibration["stiffness_scale"] == pytest.approx(0.5, rel=0.01)
+    doc = json.loads(spring.read_text())
+    doc["study"], doc["design"] = "wolfgang_knee", {**doc["design"], "beam_count": 11}
+    spring.write_text(json.dumps(doc))
+    with pytest.raises(SpringSourceError, match="is not a candidate of study 'wolfgang_knee'"):
+        explain_file(tmp_path / "bench.csv", spring, out_dir=tmp_path / "o")
+
 ANGLE_STEP_RAD = 2 * np.pi / 4096  # a 12-bit encoder
 NOISE_NM = 0.02
 

@@ -5,14 +5,16 @@ what was declared.
    declared effects at their declared values. Its error is the "before".
 2. The declared model refitted (`base`): every declared parameter free, started at its declared
    value, and the stiffness scale (the declared k is always refitted).
-3. Forward selection: each undeclared effect of the library that applies is fitted together with
+3. Forward selection: each undeclared effect of the library that applies (and on a bench with the spring's own
+   part, the material law's shape, `loop.law_family`) is fitted together with
    the current model (screened first with the declared effects but the stiffness scale held; the
    `screen` best, and any the screen accepts, refitted with everything free); it is accepted when it cuts the held-out RMSE by at least `min_gain` (5 %)
    and lowers the training BIC by at least `min_bic_drop` (10, "very strong" evidence). The winner
    is the accepted one with the lowest held-out RMSE, except that a fit pinned at a search bound
    wins only when no accepted fit lies inside its bounds. When the runner-up is as good (held-out
    RMSE within `ambiguity`, 3 %) and the two together do not beat the winner by `min_gain`, the data
-   cannot tell them apart: the step is reported as an ambiguity with both fits, not a single name.
+   cannot tell them apart: the step is reported as an ambiguity with both fits, not a single name (a law shape
+   then goes first: the part's own law before a phenomenological term).
    A sensor step is proposed at the instant change-point detection finds in the current residual, searched
    between 10 % and 90 % of the record (none when the largest jump is at that limit), then found again in the
    residual of its own fit without it, where the current model no longer bends around the jump, until it stays.
@@ -270,6 +272,8 @@ def explain(data: LoopData, declared: Sequence[Effect] = (), *, exclude: Sequenc
             break
         best = winners[0]
         alt = _alternative(data, held, best, winners[1:], ambiguity, min_gain)
+        if alt is not None and alt.effect in LAW_SHAPES and best.effect not in LAW_SHAPES:
+            best, alt = alt, best  # as good: the part's own law before a phenomenological term
         steps.append(Step(best.effect, current, best.fit, trace, alt))
         current = best.fit
     checks, current = _check_declared(data, held, current, decl, gate)
