@@ -5,6 +5,7 @@ evaluation, and the report opens in a browser with the decision first."""
 from __future__ import annotations
 
 import json
+import re
 
 import pandas as pd
 import pytest
@@ -62,6 +63,11 @@ def test_explore_command(tmp_path):
         result.output
     calibrated = pd.read_csv(tmp_path / "out" / "tinyx-calibrated" / "results.csv")
     assert calibrated.loc[0, "k_Nm_per_rad"] == pytest.approx(0.5 * t.loc[0, "k_Nm_per_rad"], rel=1e-9)
+    # the uncalibrated choice evaluated again with the calibrated material, beside the calibrated choice
+    assert "calibration: the choice without and with it, each judged with the calibrated material:" in result.output
+    old = re.search(r"uncalibrated choice, calibrated material: 3 beams x 8 mm: misses (.*)", result.output).group(1)
+    new = re.search(r"  calibrated choice: 3 beams x 8 mm: misses (.*)", result.output).group(1)
+    assert old == new == calibrated.loc[0, "failed_constraints"]  # the same design judged alike both ways
 
 
 @pytest.mark.slow  # two explorations of one full path each

@@ -259,3 +259,20 @@ def test_a_yeoh_bench_curve_is_told_apart_or_said_to_be_indistinguishable(bench_
         assert "the Mooney-Rivlin and Yeoh shapes and the material's law are indistinguishable" in verdict
         assert "shape_unsupported" in found.calibration["law"]
     assert found.calibration["law"]["mu_Pa"] == pytest.approx(true.shear_modulus_Pa, rel=0.02)
+
+
+@pytest.mark.slow
+def test_a_spring_json_whose_curve_its_study_no_longer_gives_is_refused(bench_spring, monkeypatch, tmp_path):
+    """The study's candidate under the material's law must give spring.json's curve point by point (any change of
+    study, material, solver or code since the sweep shows there)."""
+    from seadesign.loop.law_family import SpringSourceError, spring_source
+
+    folder, spring_path = bench_spring
+    monkeypatch.chdir(folder)
+    monkeypatch.setenv("SEADESIGN_CACHE", str(folder / "cache"))
+    spring = json.loads(spring_path.read_text())
+    assert spring_source(spring).candidate.name == "6 beams x 8 mm"
+    spring["torque_curve"]["torque_Nm"] = [1.0001 * t for t in spring["torque_curve"]["torque_Nm"]]
+    with pytest.raises(SpringSourceError, match=f"no longer matches study '{STUDY}': its candidate 6 beams x 8 mm now "
+                                                f"ends at .* rerun `seadesign sweep {STUDY}`"):
+        spring_source(spring)

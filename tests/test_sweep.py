@@ -281,3 +281,9 @@ def test_calibrated_sweep_reranks_and_judges_the_standing_load(tiny, tmp_path):
     assert "calibration: choice unchanged: 3 beams x 8 mm -> 3 beams x 8 mm" in result.output
     assert "does NOT carry the standing load" in result.output
     assert pd.read_parquet(out / "tiny" / "results.parquet")["k_Nm_per_rad"].equals(base["k_Nm_per_rad"])
+    # the report names what was calibrated and shows both choices side by side, judged with the calibrated material
+    report = (out / "tiny-calibrated" / "report.md").read_text()
+    assert "Calibrated: calibrated from cal.json" in report
+    verdict = "yes" if bool(c["feasible"]) else "no"
+    for label in ("uncalibrated choice", "calibrated choice"):
+        assert f"| {label} | 3 beams x 8 mm | {verdict} |" in report

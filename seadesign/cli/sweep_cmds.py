@@ -66,12 +66,13 @@ def _sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: 
 
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
     s = load_study(study)
-    baseline = None
+    baseline = note = None
     if calibration is not None:
         baseline = s
         s, note = apply_calibration(s, calibration)
         click.echo(note)
     result = sweep_and_write(s, out_dir, baseline=baseline, jobs=jobs, quiet=quiet, executor=executor,
-                             scheduler=scheduler, export_all=export_all, cache_dir=cache_dir, tolerance_mm=tolerance_mm)
+                             scheduler=scheduler, export_all=export_all, cache_dir=cache_dir, tolerance_mm=tolerance_mm,
+                             calibration_note=note)
     for line in result.lines(quiet):
         click.echo(line)

@@ -228,6 +228,41 @@ class Study:
             given[axis.key] = axis.exact(value)
         return self._candidate(tuple((k, given[k]) for k in keys))
 
+    def candidate_of(self, spring: dict) -> Candidate:
+        """The candidate a spring.json document describes: its `design` values (and material) on this study's axes.
+
+        Parameters
+        ----------
+        spring : dict
+            A spring.json document (``design``: geometry in mm and deg, ``material``: its ``name``).
+
+        Returns
+        -------
+        Candidate
+            Unchecked (see `check`).
+
+        Raises
+        ------
+        ConfigError
+            The document lacks an axis's value, or the value is outside this study's design space (named).
+
+        Examples
+        --------
+        >>> import seadesign as sd
+        >>> sd.load_study("wolfgang_knee").candidate_of({"design": {"beam_count": 6, "beam_thickness_mm": 8.0}}).name
+        '6 beams x 8 mm'
+        """
+        values = {}
+        for axis in self.axes:
+            node = spring.get("material", {}).get("name") if axis.key == MATERIAL_KEY else spring.get("design", {})
+            for part in ([] if axis.key == MATERIAL_KEY else axis.key.split(".")):
+                node = node.get(part) if isinstance(node, dict) else None
+            if node is None:
+                raise ConfigError(f"spring.json has no value for study '{self.name}''s axis {axis.key} "
+                                  f"({'material/name' if axis.key == MATERIAL_KEY else 'design/' + axis.key.replace('.', '/')})")
+            values[axis.key] = node
+        return self.candidate(**values)
+
     def check(self, candidate: Candidate) -> tuple[Candidate, "Part"]:
         """Build a candidate's solid with CadQuery and check it with this study's validity rules.
 

@@ -212,4 +212,34 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
                         scheduler=scheduler, quiet=quiet)
     written = write_exploration(study, run.problem, run.exploration, run.decision, run.sobol, folder, run.settings,
                                 solver=solver, cache=cache, tolerance_mm=tolerance_mm)
+    if calibration is not None:
+        note += "\n" + uncalibrated_choice_text(study, Path(out_dir) / study.name, run, folder, solver, cache)
     return ExplorationResult(study, run, folder, written, note)
+
+
+def uncalibrated_choice_text(study: Study, uncalibrated: Path, run, folder: Path, solver, cache) -> str:
+    """The uncalibrated exploration's choice (its spring.json in `uncalibrated`) beside the calibrated one, each
+    judged with the calibrated material: the old design is evaluated once more (`sweep.runner.run_candidates`)."""
+    import json
+
+    from seadesign.sweep.rank import rank
+    from seadesign.sweep.runner import run_candidates
+
+    old = uncalibrated / "spring.json"
+    if not old.exists():
+        return (f"no uncalibrated exploration in {uncalibrated} to compare with: run `seadesign explore {study.name}` "
+                f"without --calibration first")
+    design = study.candidate_of(json.loads(old.read_text()))
+    rows = run_candidates(study, [design], folder / "uncalibrated_choice", settings=solver, cache=cache, quiet=True).rows
+    judged = rank(rows, study)[0].iloc[0]
+
+    def verdict(feasible: bool, misses: str) -> str:
+        return "meets every requirement" if feasible else f"misses {misses}"
+
+    lines = [f"  uncalibrated choice, calibrated material: {design.name}: "
+             f"{verdict(bool(judged['feasible']), str(judged['failed_constraints']))}"]
+    if run.decision.index is not None:
+        row = run.exploration.evaluated.loc[run.decision.index]
+        lines.append(f"  calibrated choice: {row['candidate']}: "
+                     f"{verdict(bool(row['feasible']), str(row.get('failed_constraints', '')))}")
+    return "\n".join(["calibration: the choice without and with it, each judged with the calibrated material:", *lines])

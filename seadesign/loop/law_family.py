@@ -6,7 +6,8 @@ modulus mu = 2 (C10 + C01), for Yeoh the ratio C20 / C10. A `LawFamily` holds th
 spring's own part (the study and candidate of spring.json, `spring_source`) at a few values of that parameter,
 each at the material's mu and compressibility, and interpolates between them: quadratic (Lagrange) in the
 parameter at each rotation, the curves being smooth in the law's parameters. Its error against full paths at the
-midpoints is measured in docs/validation (`benchmarks/law_family.py`) and tested.
+midpoints is measured by `benchmarks/law_fit.py` (docs/validation/loop.md); on a closed-form family the
+interpolation is tested to be exact.
 
 The paths come from the stage cache (the material's own one is the sweep's). spring.json is refused when its study
 cannot be loaded, or when its candidate under the material's law no longer gives spring.json's torque curve (the
@@ -23,7 +24,6 @@ import numpy as np
 
 from seadesign.design.candidate import Candidate
 from seadesign.design.materials import Hyperelastic, Material
-from seadesign.design.space import MATERIAL_KEY
 from seadesign.design.spring import TorqueCurve, torque_curve
 from seadesign.design.study import Study, load_study
 from seadesign.effects.base import Effect, Param
@@ -86,19 +86,6 @@ class SpringSource:
         return candidate_path(self.study, replace(self.candidate, material=material))
 
 
-def _candidate(study: Study, spring: dict[str, Any]) -> Candidate:
-    values = {}
-    for axis in study.axes:
-        if axis.key == MATERIAL_KEY:
-            values[axis.key] = spring["material"]["name"]
-            continue
-        node: Any = spring["design"]
-        for part in axis.key.split("."):
-            node = node[part]
-        values[axis.key] = node
-    return study.candidate(**values)
-
-
 def path_curve(path: CandidatePath) -> TorqueCurve:
     """A path's torque curve as spring.json carries it (up to its stop, `sweep.handoff.curve_to_stop`)."""
     r = path.result
@@ -125,8 +112,8 @@ def spring_source(spring: dict[str, Any]) -> SpringSource:
                                 f"recomputed for trial laws; run `seadesign explain` where the study is, or fit the "
                                 f"scale alone (--law scale)") from None
     try:
-        candidate = _candidate(study, spring)
-    except (ConfigError, KeyError) as exc:
+        candidate = study.candidate_of(spring)
+    except ConfigError as exc:
         raise SpringSourceError(f"spring.json's design is not a candidate of study '{name}' ({exc}): the study changed "
                                 f"since the sweep; rerun `seadesign sweep {name}`") from None
     path = candidate_path(study, candidate)

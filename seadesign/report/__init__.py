@@ -16,7 +16,7 @@ from seadesign.run.fingerprint import code_fingerprint
 from seadesign.design.spring import write_spring
 from seadesign.sweep.rank import Choice
 from seadesign.report.document import write_html, write_markdown
-from seadesign.report.sweep_page import sweep_page
+from seadesign.report.sweep_page import Baseline, sweep_page
 from seadesign.sweep.handoff import spring_document
 from seadesign.sweep.path_stage import path_key
 from seadesign.sweep.stages import SolverSettings, geometry_key
@@ -118,8 +118,8 @@ def write_renders(study: Study, row: pd.Series, folder: Path, solver: SolverSett
 
 def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, settings: dict, *,
                   solver: SolverSettings, cache: Cache, export_all: bool = False,
-                  tolerance_mm: float = 0.01) -> dict[str, list[Path]]:
-    """Write every output of a ranked sweep; returns paths by kind."""
+                  tolerance_mm: float = 0.01, baseline: Baseline | None = None) -> dict[str, list[Path]]:
+    """Write every output of a ranked sweep (a calibrated one compared with its `baseline`); returns paths by kind."""
     folder.mkdir(parents=True, exist_ok=True)
     written: dict[str, list[Path]] = {"tables": write_tables(t, settings, folder)}
     figures = write_plots(study, t, choice, folder)
@@ -137,7 +137,7 @@ def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, s
         written["spring"] = [write_handoff(study, t, row, folder, settings, selection)]
     written["cad"] = export_cad(study, cad_rows, folder, tolerance_mm)
     written["images"] = [*figures.values(), *renders.values()]
-    page = sweep_page(study, t, choice, settings, figures, renders)
+    page = sweep_page(study, t, choice, settings, figures, renders, baseline)
     written["report"] = [write_markdown(folder / "report.md", page), write_html(folder / "report.html", page)]
     return written
 

@@ -3,6 +3,7 @@ the full table and settings collapsed."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -80,8 +81,38 @@ LINEAR_NOTE = ("The linear results (k at small load, stall rotation torque / k, 
                "and yield stress against a linear stress is not a criterion.")
 
 
+@dataclass(frozen=True)
+class Baseline:
+    """The uncalibrated sweep a calibrated one is compared with: what was calibrated (`note`), its ranked table
+    and its choice."""
+
+    note: str
+    ranked: pd.DataFrame
+    choice: Choice
+
+
+def _verdict(t: pd.DataFrame, candidate: str) -> tuple[str, str]:
+    row = t.loc[t["candidate"] == candidate].iloc[0]
+    meets = "yes" if bool(row["feasible"]) else "no"
+    return meets, str(row["failed_constraints"]) or "-"
+
+
+def calibration_text(baseline: Baseline, t: pd.DataFrame, choice: Choice) -> str:
+    """The calibrated materials and the choice without and with the calibration, side by side, each judged with
+    the calibrated material."""
+    if baseline.choice.index is None or choice.index is None:
+        return f"{baseline.note}. No candidate was solved, so there is no choice to compare."
+    before = baseline.ranked.loc[baseline.choice.index, "candidate"]
+    after = t.loc[choice.index, "candidate"]
+    rows = [("uncalibrated choice", before), ("calibrated choice", after)]
+    lines = ["| | candidate | meets every requirement (calibrated material) | misses |", "|---|---|---|---|"]
+    lines += [f"| {label} | {name} | {' | '.join(_verdict(t, name))} |" for label, name in rows]
+    return (f"Calibrated: {baseline.note}. The choice {'is unchanged' if before == after else 'changes'}: "
+            f"{before} -> {after}.\n\n" + "\n".join(lines))
+
+
 def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: dict[str, Path],
-               renders: dict[str, Path]) -> Page:
+               renders: dict[str, Path], baseline: Baseline | None = None) -> Page:
     if choice.index is None:
         headline, feasible = "No candidate was solved, so none can be chosen.", False
     else:
@@ -103,7 +134,8 @@ def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: 
         table=compact_table(ranked, [("rank", "rank")]),
         table_caption=f"Ranked candidates (the first {len(ranked)})",
         figures=figures, renders=renders,
-        sections=[("Study", study_text(study)), ("Objectives", objectives_text(study)), ("Linear model", LINEAR_NOTE),
+        sections=([("Calibration", calibration_text(baseline, t, choice))] if baseline is not None else []) + [
+                  ("Study", study_text(study)), ("Objectives", objectives_text(study)), ("Linear model", LINEAR_NOTE),
                   ("Input files", study.files.describe())],
         details=[("All candidates (full table)", summary_table(t)),
                  ("Settings and versions", ", ".join(f"{k}: {v}" for k, v in settings.items()))],

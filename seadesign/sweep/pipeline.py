@@ -245,7 +245,7 @@ class SweepResult:
 def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, baseline: Study | None = None,
                 jobs: int | None = None, quiet: bool = False, executor: str = "local", scheduler: str | None = None,
                 export_all: bool = False, cache_dir: str | Path | None = None,
-                tolerance_mm: float = 0.01) -> SweepResult:
+                tolerance_mm: float = 0.01, calibration_note: str | None = None) -> SweepResult:
     """Sweep a loaded study (see `sweep_study`); with `baseline`, `study` is its calibrated form, written to
     ``OUT/<study>-calibrated/``, and the baseline is swept too for the comparison.
 
@@ -259,6 +259,8 @@ def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, base
         The uncalibrated study `study` was calibrated from (`apply_calibration`).
     jobs, quiet, executor, scheduler, export_all, cache_dir, tolerance_mm
         As in `sweep_study`.
+    calibration_note : str, optional
+        What the calibration changed (`apply_calibration`'s note), said in the report's Calibration section.
 
     Returns
     -------
@@ -275,6 +277,7 @@ def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, base
     >>> result = sweep_and_write(load_study("wolfgang_knee"), "exports", jobs=2)
     """
     from seadesign.report import write_outputs
+    from seadesign.report.sweep_page import Baseline
 
     cache = default_cache(cache_dir)
     solver = SolverSettings()
@@ -283,12 +286,13 @@ def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, base
     options = dict(settings=solver, cache=cache, executor=executor, jobs=jobs, scheduler=scheduler, quiet=quiet)
     run = run_sweep(study, folder, **options)
     ranked, choice = rank(run.rows, study)
-    written = write_outputs(study, ranked, choice, folder, sweep_settings(study, solver), solver=solver, cache=cache,
-                            export_all=export_all, tolerance_mm=tolerance_mm)
-    comparison = None
+    comparison = compared = None
     if baseline is not None:
         base_ranked, base_choice = rank(run_sweep(baseline, out_dir / baseline.name, **options).rows, baseline)
         comparison = calibration_summary(base_ranked, base_choice, ranked, choice, study)
+        compared = Baseline(calibration_note or "the calibration file's material", base_ranked, base_choice)
+    written = write_outputs(study, ranked, choice, folder, sweep_settings(study, solver), solver=solver, cache=cache,
+                            export_all=export_all, tolerance_mm=tolerance_mm, baseline=compared)
     return SweepResult(study, ranked, choice, run, folder, written, comparison)
 
 
@@ -346,7 +350,8 @@ def sweep_study(study: str | Path | Study = DEFAULT_STUDY.stem, out_dir: str | P
     baseline = None
     if calibration is not None:
         baseline = study
-        study, _ = apply_calibration(study, calibration)
+        study, note = apply_calibration(study, calibration)
     return sweep_and_write(study, out_dir, baseline=baseline, jobs=jobs, quiet=quiet, executor=executor,
-                       scheduler=scheduler, export_all=export_all, cache_dir=cache_dir, tolerance_mm=tolerance_mm)
+                           scheduler=scheduler, export_all=export_all, cache_dir=cache_dir, tolerance_mm=tolerance_mm,
+                           calibration_note=note if baseline is not None else None)
 
