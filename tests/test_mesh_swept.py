@@ -51,6 +51,7 @@ def test_prismatic_parts_are_detected_and_others_meshed_in_3d(tmp_path):
     assert volume == pytest.approx(counterbored.Volume(), rel=0.01)
 
 
+@pytest.mark.slow  # about 50 s: two meshes and two solves
 def test_swept_and_free_3d_meshes_give_the_same_stiffness(tmp_path):
     """Two different meshes of the same part converge to the same k: agreement within 1 %."""
     solid, ifc = holed_annulus()

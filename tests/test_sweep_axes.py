@@ -35,6 +35,7 @@ def thickness_study(folder: Path) -> Path:
     return path
 
 
+@pytest.mark.slow  # about 45 s: a sweep of several thicknesses through the path
 def test_axial_thickness_axis_sweeps_ranks_reports_and_hands_off(tmp_path):
     path = thickness_study(tmp_path)
     study = load_study(path)

@@ -13,6 +13,7 @@ from sweep_helpers import write_tiny_study
 pytest.importorskip("distributed")
 
 
+@pytest.mark.slow  # about 45 s: a local cluster's start and a sweep on it
 def test_dask_local_cluster_matches_serial_and_reports_stages(tmp_path, monkeypatch):
     # one valid candidate (meshed and solved on a Dask worker) and one invalid one
     study = load_study(write_tiny_study(tmp_path, beam_count="[3, 10]", beam_thickness_mm="[8.0]"))

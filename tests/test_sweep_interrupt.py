@@ -46,7 +46,7 @@ def _running_in_group(pgid: int) -> list[psutil.Process]:
 
 
 @pytest.mark.parametrize("executor, sig, target", [
-    pytest.param("local", signal.SIGINT, "group", id="local-ctrl-c"),
+    pytest.param("local", signal.SIGINT, "group", id="local-ctrl-c", marks=pytest.mark.slow),  # ~70 s; SIGTERM stays
     pytest.param("local", signal.SIGTERM, "main", id="local-sigterm"),
     pytest.param("dask", signal.SIGINT, "group", id="dask-ctrl-c", marks=pytest.mark.slow),
     pytest.param("dask", signal.SIGTERM, "main", id="dask-sigterm", marks=pytest.mark.slow),
