@@ -161,15 +161,15 @@ class Explanation:
                      f"binned share of variance {s['explained_share_binned']:.3g}).")
         return text
 
-
     def law_shape_text(self) -> str:
         """Which law shape the held-out error prefers, or that the data cannot tell the shapes apart."""
         named = next((t.key for t in self.final.terms if t.key in LAW_SHAPES), None)
         if named is None:
             tried = [t for t in self.last_trace if t.effect in LAW_SHAPES]
             best = min(tried, key=lambda t: t.held_out_rmse, default=None)
-            scores = f" (best: {best.effect}, held-out RMSE {best.held_out_rmse:.4g} against {self.final.errors['held_out']['rmse']:.4g})" \
-                if best is not None else ""
+            own = self.final.errors["held_out"]["rmse"]
+            scores = "" if best is None else \
+                f" (best: {best.effect}, held-out RMSE {best.held_out_rmse:.4g} against {own:.4g})"
             return (f"No law shape beats the material's own on held-out data{scores}: over this file's strains the "
                     f"Mooney-Rivlin and Yeoh shapes and the material's law are indistinguishable, so the shape is not "
                     f"identified and mu's uncertainty in the calibration includes the shape-free fit's.")
