@@ -125,17 +125,22 @@ def test_cache_hit_and_load_change_reuses_the_solve(tiny, tmp_path):
 
 
 @pytest.mark.slow
-def test_modulus_change_resolves_on_the_cached_mesh(tiny, tmp_path):
-
+def test_a_modulus_change_reuses_the_mesh_and_the_linear_solves(tiny, tmp_path):
+    """A calibration that changes only the modulus solves the paths again but neither the mesh nor the linear
+    solves; the rows follow linear elasticity at a fixed Poisson ratio: k and the coarse k as E, the rotation as
+    1 / E, the stresses unchanged."""
     study_path, cache_dir, _ = tiny
     s = load_study(study_path)
-    base = run_sweep(s, tmp_path / "a", cache=Cache(cache_dir), jobs=1, quiet=True)
-    meshes = set((cache_dir / "mesh").rglob("*"))
+    base = run_sweep(s, tmp_path / "a", cache=Cache(cache_dir), jobs=1, quiet=True).rows.loc[0]
+    meshes, linear, paths = (set((cache_dir / stage).rglob("*")) for stage in ("mesh", "fea", "path"))
     stiff = s.with_materials({s.material.key: s.material.scaled(2.0, "test")})
-    r = run_sweep(stiff, tmp_path / "b", cache=Cache(cache_dir), jobs=1, quiet=True)
-    assert set((cache_dir / "mesh").rglob("*")) == meshes
-    # linear elasticity at fixed Poisson ratio: k proportional to E
-    assert r.rows.loc[0, "k_Nm_per_rad"] == pytest.approx(2 * base.rows.loc[0, "k_Nm_per_rad"], rel=1e-6)
+    r = run_sweep(stiff, tmp_path / "b", cache=Cache(cache_dir), jobs=1, quiet=True).rows.loc[0]
+    assert set((cache_dir / "mesh").rglob("*")) == meshes and set((cache_dir / "fea").rglob("*")) == linear
+    assert r["k_Nm_per_rad"] == pytest.approx(2 * base["k_Nm_per_rad"], rel=1e-14)
+    assert r["k_coarse_Nm_per_rad"] == pytest.approx(2 * base["k_coarse_Nm_per_rad"], rel=1e-14)
+    assert r["stall_rotation_rad"] == pytest.approx(base["stall_rotation_rad"] / 2, rel=1e-14)
+    assert r["stall_von_mises_max_MPa"] == base["stall_von_mises_max_MPa"]
+    assert set((cache_dir / "path").rglob("*")) > paths  # the path is solved again
 
 
 def test_warm_rerun_keeps_unchanged_outputs_and_redraws_changed_ones(tiny, tmp_path):

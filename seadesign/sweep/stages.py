@@ -11,13 +11,17 @@ Meshing is `seadesign.mesh.mesh_part`, the solve `seadesign.fea.loadcases.analys
 load case; a second P2 solve on a mesh COARSENING times coarser (`coarse_k`, a stage of its own)
 gives the discretization-error estimate of k (two-level Richardson at CONVERGENCE_ORDER, the smallest
 order observed in benchmarks/fea_convergence.py).
+
+Both linear solves are made and cached at REFERENCE_MODULUS_PA and scaled to the material's modulus by
+the rules of `fea.results` (k as E; rotations and displacements as 1 / E; stresses and reactions do not
+change): a sweep whose only change is the modulus, a calibrated one, reuses them.
 """
 
 from __future__ import annotations
 
 import functools
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
@@ -34,6 +38,7 @@ if TYPE_CHECKING:
 Progress = Callable[[str], None]  # receives the name of the stage that starts
 COARSENING = 1.5  # edge-length ratio of the error-estimate mesh to the result mesh
 CONVERGENCE_ORDER = 1.1  # smallest order of k observed in benchmarks/fea_convergence.py (1.10-1.89)
+REFERENCE_MODULUS_PA = 1e7  # Young's modulus of the cached linear solves (Pa), of a TPU's order
 
 
 @dataclass(frozen=True)
@@ -83,10 +88,11 @@ def mesh_key(study: Study, candidate: Candidate) -> str:
 
 
 def fea_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
-    """Inputs of the unit response: the mesh, the material, the solver settings, and the code of
-    this module with everything it imports (the solver, the mesher, the study's mesh sizing)."""
+    """Inputs of the unit response at REFERENCE_MODULUS_PA: the mesh, the material's Poisson ratio and yield
+    strength, the solver settings, and the code of this module with everything it imports (the solver, the
+    mesher, the study's mesh sizing)."""
     m = candidate.material
-    return digest("fea", mesh_key(study, candidate), m.youngs_modulus_Pa, m.poisson_ratio,
+    return digest("fea", mesh_key(study, candidate), REFERENCE_MODULUS_PA, m.poisson_ratio, m.yield_strength_Pa,
                   settings.element_order, settings.linear_solver,
                   code_fingerprint("seadesign.sweep.stages", "seadesign.mesh.worker"), package_versions())
 
@@ -124,12 +130,12 @@ def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache,
 
 
 def unit_response(mesh, study: Study, candidate: Candidate, settings: SolverSettings) -> UnitResponse:
-    """Both load cases at 1 Nm."""
+    """Both load cases at 1 Nm, at REFERENCE_MODULUS_PA."""
     from seadesign.fea.loadcases import analyse
 
     m = candidate.material
     t0 = time.perf_counter()
-    a = analyse(mesh, m.youngs_modulus_Pa, m.poisson_ratio, m.yield_strength_Pa, 1.0, 1.0, study.bearing_radius_mm,
+    a = analyse(mesh, REFERENCE_MODULUS_PA, m.poisson_ratio, m.yield_strength_Pa, 1.0, 1.0, study.bearing_radius_mm,
                 order=settings.element_order, linear_solver=settings.linear_solver)
     return UnitResponse(
         results=a.results,
@@ -156,18 +162,17 @@ def part_source(study: Study, candidate: Candidate, built: Part | None, progress
 
 def fea_response(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings, cache: Cache,
                  progress: Progress) -> UnitResponse:
-    """Unit response via the cache: the part and the mesh (cached) are made only when the solve is not
-    cached."""
+    """Unit response at the material's modulus via the cache: the part and the mesh (cached) are made only
+    when the solve is not cached."""
     fkey = fea_key(study, candidate, settings)
     unit = cache.get("fea", fkey)
-    if unit is not None:
-        return unit
-    progress("mesh")
-    mesh = tetrahedralize(study, candidate, part(), cache)
-    progress("fea")
-    unit = unit_response(mesh, study, candidate, settings)
-    cache.put("fea", fkey, unit)
-    return unit
+    if unit is None:
+        progress("mesh")
+        mesh = tetrahedralize(study, candidate, part(), cache)
+        progress("fea")
+        unit = unit_response(mesh, study, candidate, settings)
+        cache.put("fea", fkey, unit)
+    return replace(unit, results=unit.results.with_modulus(candidate.material.youngs_modulus_Pa / REFERENCE_MODULUS_PA))
 
 
 def coarse_k(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings, cache: Cache,
@@ -177,16 +182,15 @@ def coarse_k(study: Study, candidate: Candidate, part: Callable[[], Part], setti
     from seadesign.fea.torsion import solve_unit_torsion
 
     key = coarse_k_key(study, candidate, settings)
-    hit = cache.get("coarse_k", key)
-    if hit is not None:
-        return hit
-    progress("mesh")
-    mesh = tetrahedralize(study, candidate, part(), cache, COARSENING)
-    progress("fea")
-    m = candidate.material
-    t0 = time.perf_counter()
-    coarse = solve_unit_torsion(mesh, m.youngs_modulus_Pa, m.poisson_ratio, order=settings.element_order,
-                                linear_solver=settings.linear_solver)
-    result = CoarseK(1.0 / float(coarse.hub_motion[5]), time.perf_counter() - t0)
-    cache.put("coarse_k", key, result)
-    return result
+    result = cache.get("coarse_k", key)
+    if result is None:
+        progress("mesh")
+        mesh = tetrahedralize(study, candidate, part(), cache, COARSENING)
+        progress("fea")
+        t0 = time.perf_counter()
+        coarse = solve_unit_torsion(mesh, REFERENCE_MODULUS_PA, candidate.material.poisson_ratio,
+                                    order=settings.element_order, linear_solver=settings.linear_solver)
+        result = CoarseK(1.0 / float(coarse.hub_motion[5]), time.perf_counter() - t0)
+        cache.put("coarse_k", key, result)
+    return replace(result, k_coarse_Nm_per_rad=result.k_coarse_Nm_per_rad * candidate.material.youngs_modulus_Pa
+                   / REFERENCE_MODULUS_PA)
