@@ -60,6 +60,7 @@ import torch
 from torch import nn
 from torch.nn.utils import parametrize
 
+from seadesign.corrector.early_stopping import KeepBest
 from seadesign.corrector.closedloop import CHATTER_RMS_RAD, chatter_rms
 from seadesign.corrector.export import NumpyClosedLoop
 from seadesign.corrector.imitation import TRAIN_K_SCALES, TRAIN_SPEEDS
@@ -376,7 +377,7 @@ def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> Cl
     n_windows = -(-n_steps // s.window_steps)
     target_val = b.target[b.val_rows].numpy()
     curve: list[dict] = []
-    best, best_epoch, best_state, stale, stopped = float("inf"), 0, None, 0, "max_epochs"
+    stop, best_state, stopped = KeepBest(s.patience, s.min_improvement), None, "max_epochs"
     simulated = trained = 0
     for epoch in range(s.max_epochs + 1):
         policy.eval()
@@ -388,16 +389,12 @@ def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> Cl
         row = {"epoch": epoch, "val_mean_abs_error_rad": val_err, "val_rest_chatter_rad": chatter,
                "train_loss": float("nan"), "bptt_s": 0.0, "elapsed_s": time.perf_counter() - t0}
         curve.append(row)
-        if calm and val_err < best * (1.0 - s.min_improvement):
-            stale = 0
-        else:
-            stale += 1
+        if stop.update(epoch, val_err, admissible=calm):
+            best_state = copy.deepcopy(policy.state_dict())
+        if not stop.improved:
             for group in opt.param_groups:
                 group["lr"] *= s.lr_decay
-        if calm and val_err < best:
-            best, best_epoch = val_err, epoch
-            best_state = copy.deepcopy(policy.state_dict())
-        if stale >= s.patience:
+        if stop.exhausted:
             stopped = "patience"
             break
         if epoch == s.max_epochs:
@@ -429,7 +426,7 @@ def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> Cl
                              "lower lipschitz_rad_per_rad or raise rate_weight_s2")
     policy.load_state_dict(best_state)
     policy.eval()
-    return ClosedLoopResult(policy, s, curve, best_epoch, stopped, time.perf_counter() - t0, simulated, trained)
+    return ClosedLoopResult(policy, s, curve, stop.best_epoch, stopped, time.perf_counter() - t0, simulated, trained)
 
 
 # -- export --------------------------------------------------------------------------------------------------

@@ -17,6 +17,7 @@ from torch import nn
 
 from seadesign.corrector.dataset import CorrectorDataset
 from seadesign.corrector.models import CorrectorNet, SiameseCore, base_weights, make_core
+from seadesign.corrector.early_stopping import KeepBest
 from seadesign.corrector.splits import Split
 from seadesign.errors import SeadesignError
 
@@ -133,7 +134,7 @@ def _fit(X_np: np.ndarray, y_np: np.ndarray, split: Split, w: torch.Tensor, cfg:
         return loss
 
     curve: list[dict] = []
-    best, best_epoch, best_state, stale, stopped = float("inf"), 0, None, 0, "max_epochs"
+    stop, best_state, stopped = KeepBest(cfg.patience), None, "max_epochs"
     t0, seen = time.perf_counter(), 0
     for epoch in range(cfg.max_epochs):
         net.train()
@@ -152,12 +153,9 @@ def _fit(X_np: np.ndarray, y_np: np.ndarray, split: Split, w: torch.Tensor, cfg:
             val = float(((net(X[va.to(dev)]) - y[va.to(dev)]) ** 2).mean())
         curve.append({"epoch": epoch, "train_loss_std": total / len(perm), "val_mse_rad2": val,
                       "elapsed_s": time.perf_counter() - t0})
-        if val < best - 1e-12:
-            best, best_epoch, stale = val, epoch, 0
+        if stop.update(epoch, val):
             best_state = {k_: v.detach().clone() for k_, v in net.state_dict().items()}
-        else:
-            stale += 1
-        if stale >= cfg.patience:
+        if stop.exhausted:
             stopped = "patience"
             break
         if time.perf_counter() - t0 > cfg.max_seconds:
@@ -167,4 +165,4 @@ def _fit(X_np: np.ndarray, y_np: np.ndarray, split: Split, w: torch.Tensor, cfg:
     if best_state is not None:
         net.load_state_dict(best_state)
     net.cpu().eval()
-    return TrainResult(net, cfg, curve, best_epoch, stopped, wall, seen / wall if wall > 0 else 0.0, str(dev))
+    return TrainResult(net, cfg, curve, stop.best_epoch, stopped, wall, seen / wall if wall > 0 else 0.0, str(dev))
