@@ -27,5 +27,5 @@ def test_without_a_threshold_any_lower_value_resets_the_patience():
 
 
 def test_an_inadmissible_epoch_is_never_the_best_and_is_stale():
-    stop, kept, ended = _run([5.0, 1.0, 4.0, 3.0], admissible=[True, False, True, True], patience=3)
-    assert kept == [0, 2, 3] and stop.best == 3.0 and ended is None and stop.improved
+    stop, kept, ended = _run([5.0, 1.0, 6.0, 6.0, 3.0], admissible=[True, False, True, True, True], patience=3)
+    assert kept == [0] and stop.best == 5.0 and ended == 3
