@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -95,7 +96,7 @@ def test_real_recordings_train_and_beat_no_correction():
     ds = build_dataset(recs, spec)
     assert np.isfinite(ds.X).all() and len(ds) > 8000
     sp = time_block_split(ds)
-    res = fit(ds, sp, 9.106, TrainConfig(model="mlp", max_epochs=40, patience=10, batch_size=1024))
+    res = fit(ds, sp, 9.106, TrainConfig(model="mlp", max_epochs=40, patience=10, batch_size=1024, max_seconds=math.inf))
     net = NetCorrector(NumpyCorrector(numpy_arrays(res.net)), spec, "mlp")
     table, _ = open_loop_table([NoCorrection(), net], recs, ds, sp.test, sp.name)
     both = table[table.knee == "both"].set_index("candidate")
