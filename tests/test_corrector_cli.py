@@ -79,7 +79,7 @@ def test_train_then_evaluate_writes_tables_plots_and_json(tmp_path, spring_dict)
 @pytest.mark.shared
 def test_real_recordings_train_and_beat_no_correction():
     """On the thesis's recordings (cleaned by the data module), an MLP on the thesis task beats
-    sending the target unchanged on held-out time blocks."""
+    sending the target unchanged on held-out time blocks, by more than ten times (measured 16.2 times with these 40 epochs)."""
     from seadesign.corrector.dataset import DatasetSpec, build_dataset
     from seadesign.corrector.evaluate import open_loop_table
     from seadesign.corrector.export import NumpyCorrector, numpy_arrays
@@ -100,7 +100,7 @@ def test_real_recordings_train_and_beat_no_correction():
     net = NetCorrector(NumpyCorrector(numpy_arrays(res.net)), spec, "mlp")
     table, _ = open_loop_table([NoCorrection(), net], recs, ds, sp.test, sp.name)
     both = table[table.knee == "both"].set_index("candidate")
-    assert both.loc["mlp", "mae_rad"] < both.loc["none", "mae_rad"]
+    assert both.loc["mlp", "mae_rad"] < 0.1 * both.loc["none", "mae_rad"]  # measured 1 / 16.2
 
 
 def _with_curve(spring_dict: dict, end_Nm: float, hard_stop: bool = False) -> dict:
