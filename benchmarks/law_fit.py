@@ -61,8 +61,9 @@ def main() -> None:
     from seadesign.loop.law_family import FAMILIES, law_families, path_curve, spring_source, trial_law
 
     spring = json.loads(args.spring.read_text())
-    print(f"machine: {machine()}; spring {args.spring} ({spring['study']}); cache "
-          f"{'empty (--cold)' if args.cold else 'as it is'}")
+    cache = ("the sweep's geometry, meshes and linear solves only (--sweep)" if args.sweep
+             else "empty (--cold)" if args.cold else "as it is")
+    print(f"machine: {machine()}; spring {args.spring} ({spring['study']}); cache {cache}")
     t0 = time.perf_counter()
     source = spring_source(spring)
     t_source = time.perf_counter() - t0
