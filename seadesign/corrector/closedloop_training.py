@@ -60,8 +60,8 @@ import torch
 from torch import nn
 from torch.nn.utils import parametrize
 
-from seadesign.corrector.early_stopping import KeepBest
 from seadesign.corrector.closedloop import CHATTER_RMS_RAD, chatter_rms
+from seadesign.corrector.early_stopping import KeepBest
 from seadesign.corrector.export import NumpyClosedLoop
 from seadesign.corrector.imitation import TRAIN_K_SCALES, TRAIN_SPEEDS
 from seadesign.corrector.models import CorrectorNet, MLPCore

@@ -16,8 +16,8 @@ import torch
 from torch import nn
 
 from seadesign.corrector.dataset import CorrectorDataset
-from seadesign.corrector.models import CorrectorNet, SiameseCore, base_weights, make_core
 from seadesign.corrector.early_stopping import KeepBest
+from seadesign.corrector.models import CorrectorNet, SiameseCore, base_weights, make_core
 from seadesign.corrector.splits import Split
 from seadesign.errors import SeadesignError
 
