@@ -32,6 +32,8 @@ from seadesign import __version__
 from seadesign.corrector.closedloop_training import (FINE_TUNING, ClosedLoopResult, ClosedLoopSettings, runtime_corrector,
                                                      train_closed_loop)
 from seadesign.corrector.export import load_meta, load_numpy, load_torchscript
+from seadesign.corrector.imitation import ImitationSettings
+from seadesign.corrector.pipeline import CAPS_S
 from seadesign.corrector.reference import Preview
 from seadesign.corrector.runtime import STEP_BUDGET_US
 from seadesign.corrector.workflow import export_closedloop_bundle, train_closedloop_bundle, train_reference_bundle
@@ -103,7 +105,7 @@ def main() -> None:
     args = ap.parse_args()
     spring = load_spring(args.spring)
     k = spring["k_Nm_per_rad"]
-    base = ClosedLoopSettings(threads=args.threads)
+    base = ClosedLoopSettings(threads=args.threads, max_seconds=CAPS_S["closedloop"])  # as `seadesign train`
     knees = (len(base.directions) * (len(base.speeds) + len(base.val_speeds)) * len(base.settings)
              * len(base.k_scales) * 2)
     print(f"machine: {machine()}; torch {torch.__version__}, seadesign {__version__}; spring {args.spring} "
@@ -116,13 +118,16 @@ def main() -> None:
                 f"{args.threads}; batch {knees} knees (steps/s: samples of the batch)")
     print(settings, flush=True)
     table = Table(COLUMNS)
-    _, family1, _ = train_reference_bundle(args.spring, args.out / "reference-ilc")
+    imitation = ImitationSettings()
+    imitation = replace(imitation, train=replace(imitation.train, max_seconds=CAPS_S["reference"]))
+    _, family1, _ = train_reference_bundle(args.spring, args.out / "reference-ilc", imitation)
     family1_s = family1.label_s + family1.training.summary()["wall_s"]
     print(f"family 1: ILC labels {family1.label_s:.1f} s + network {family1.training.summary()['wall_s']:.1f} s = "
           f"{family1_s:.0f} s -> {args.out / 'reference-ilc'}", flush=True)
     table.add("family 1: ILC labels + network", "", "", "", "", f"{family1_s:.0f}", "", "", "", "", "")
     print(" | ".join(COLUMNS))
-    _, tuned, _ = train_closedloop_bundle(args.spring, args.out / "closedloop", replace(FINE_TUNING, threads=args.threads),
+    fine_tuning = replace(FINE_TUNING, threads=args.threads, max_seconds=CAPS_S["closedloop"])
+    _, tuned, _ = train_closedloop_bundle(args.spring, args.out / "closedloop", fine_tuning,
                                           family1=family1)
     table.add(*_row("family 2 fine-tuning family 1 (default)", tuned, k, args.calls))
     _print(table.rows[-1])

@@ -96,11 +96,30 @@ def test_real_recordings_train_and_beat_no_correction():
     ds = build_dataset(recs, spec)
     assert np.isfinite(ds.X).all() and len(ds) > 8000
     sp = time_block_split(ds)
-    res = fit(ds, sp, 9.106, TrainConfig(model="mlp", max_epochs=40, patience=10, batch_size=1024, max_seconds=math.inf))
+    res = fit(ds, sp, 9.106, TrainConfig(model="mlp", max_epochs=40, patience=10, batch_size=1024))
     net = NetCorrector(NumpyCorrector(numpy_arrays(res.net)), spec, "mlp")
     table, _ = open_loop_table([NoCorrection(), net], recs, ds, sp.test, sp.name)
     both = table[table.knee == "both"].set_index("candidate")
     assert both.loc["mlp", "mae_rad"] < 0.1 * both.loc["none", "mae_rad"]  # measured 1 / 16.2
+
+
+def test_the_wall_clock_cap_is_the_cli_s_and_the_library_has_none(tmp_path, spring_dict):
+    """`train --max-seconds` stops a network after its first epoch when the cap is already past; without the
+    option the CLI caps each kind as `CAPS_S` says, and the library's settings carry no cap at all."""
+    from seadesign.corrector.closedloop_training import ClosedLoopSettings
+    from seadesign.corrector.imitation import ImitationSettings
+    from seadesign.corrector.pipeline import CAPS_S
+    from seadesign.corrector.train import TrainConfig
+
+    res = CliRunner().invoke(main, ["train", "--spring", str(_spring(tmp_path, spring_dict)), "--data",
+                                    str(_recording(tmp_path, spring_dict)), "--model", "mlp", "--max-seconds", "0",
+                                    "-o", str(tmp_path / "m")])
+    assert res.exit_code == 0, res.output
+    assert "at epoch 0 (time_limit" in res.output
+    assert CAPS_S == {"network": 60.0, "reference": 600.0, "closedloop": 300.0}
+    assert "60 for a network" in " ".join(CliRunner().invoke(main, ["train", "--help"]).output.split())
+    assert math.inf == TrainConfig().max_seconds == ImitationSettings().train.max_seconds \
+        == ClosedLoopSettings().max_seconds
 
 
 def _with_curve(spring_dict: dict, end_Nm: float, hard_stop: bool = False) -> dict:

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -82,7 +80,7 @@ def test_iterate_adds_each_rounds_run_to_the_pool(spring_dict):
     from seadesign.corrector.train import TrainConfig
 
     trials = [Trial("front", 0.1, 2.0), Trial("rotate_right", 0.2, 2.0)]
-    cfg = TrainConfig(model="mlp", max_epochs=30, patience=10, batch_size=256, seed=3, max_seconds=math.inf)
+    cfg = TrainConfig(model="mlp", max_epochs=30, patience=10, batch_size=256, seed=3)
     spec = DatasetSpec(task="command", modalities="velocity_effort", positive=True)
     table, results = iterate(spring_dict, [], spec, cfg, rounds=2, trials=trials, seed=1)
     assert list(table["round"]) == [0, 1, 2] and len(results) == 3

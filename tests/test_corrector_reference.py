@@ -4,8 +4,6 @@ closed-loop comparison of family 1 with the default, family 2 fine-tuning it, in
 from __future__ import annotations
 
 import json
-import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -23,10 +21,8 @@ from seadesign.corrector.workflow import evaluate_bundles, load_corrector, train
 from seadesign.design.spring import write_spring
 from seadesign.twin import Trial, thesis_protocol
 
-# training stops on its epochs and patience, never on the machine's speed
-UNCAPPED = replace(ImitationSettings().train, max_seconds=math.inf)
 SMALL = ImitationSettings(speeds=(0.075, 0.15), settings=("hanging",), k_scales=(1.0,), trial_s=6.0,
-                          ilc=ILCSettings(max_iterations=40), train=UNCAPPED)
+                          ilc=ILCSettings(max_iterations=40))
 
 
 def test_reference_bundle_records_its_simulator_and_runs_as_trained(tmp_path):

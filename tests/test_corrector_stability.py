@@ -4,9 +4,6 @@ feed-forward with a low-gain PI is quiet and is not. Hand-made PI loops bracket 
 
 from __future__ import annotations
 
-import math
-from dataclasses import replace
-
 import numpy as np
 import pytest
 from conftest import thesis_spring
@@ -25,8 +22,6 @@ from seadesign.twin import Trial
 
 pytestmark = pytest.mark.slow  # trains two networks and runs 15 closed and broken loops: about a minute
 
-# training stops on its epochs and patience, never on the machine's speed
-UNCAPPED = replace(ImitationSettings().train, max_seconds=math.inf)
 TRIALS = [Trial("front", 0.1, 6.0), Trial("right", 0.2, 6.0), Trial("rotate_right", 0.05, 6.0)]
 
 
@@ -39,9 +34,9 @@ def learned():
     rec = recording_from_table(run.recording, "sim")[0]
     spec = DatasetSpec("command", ("motor_vel", "hall_vel", "effort"), 0, True)
     ds = build_dataset([rec], spec)
-    mlp = fit(ds, make_split(ds, "time_blocks"), spring["k_Nm_per_rad"], TrainConfig(max_seconds=math.inf, threads=1))
+    mlp = fit(ds, make_split(ds, "time_blocks"), spring["k_Nm_per_rad"], TrainConfig(threads=1))
     imitation = ImitationSettings(speeds=(0.075, 0.15), settings=("hanging",), k_scales=(1.0,), trial_s=6.0,
-                                  ilc=ILCSettings(max_iterations=40), train=UNCAPPED)
+                                  ilc=ILCSettings(max_iterations=40))
     ref = train_imitation(spring, imitation)
     return spring, NetCorrector(NumpyCorrector(numpy_arrays(mlp.net)), spec, "mlp"), \
         ReferenceFeedForward(NumpyCorrector(numpy_arrays(ref.training.net)), imitation.window, spring["k_Nm_per_rad"],

@@ -50,14 +50,16 @@ def _models(text: str) -> list[str]:
 @click.option("--seed", type=int, default=0, show_default=True)
 @click.option("--max-epochs", type=int, default=TrainConfig.max_epochs, show_default=True)
 @click.option("--patience", type=int, default=TrainConfig.patience, show_default=True, help="epochs")
-@click.option("--max-seconds", type=float, default=TrainConfig.max_seconds, show_default=True, help="s per model")
+@click.option("--max-seconds", type=float, default=None,
+              help="wall-clock cap per model, s [default: 60 for a network on recordings, 600 for the reference, "
+                   "300 for the closed loop; inf: none]")
 @click.option("--batch-size", type=int, default=TrainConfig.batch_size, show_default=True)
 @click.option("--lr", type=float, default=TrainConfig.lr, show_default=True, help="Adam learning rate")
 @click.option("-o", "--out", "out", type=click.Path(file_okay=False), default=None,
               help="bundle folder (several models: one subfolder each); default exports/<study>/corrector/")
 def train(spring_path: str, data: tuple[str, ...], model_text: str, modalities: str, task: str, positive: bool,
           history: int | None, split_name: str, test_recording: tuple[str, ...], seed: int, max_epochs: int,
-          patience: int, max_seconds: float, batch_size: int, lr: float, out: str | None) -> None:
+          patience: int, max_seconds: float | None, batch_size: int, lr: float, out: str | None) -> None:
     """Train corrector network(s) and export bundles (TorchScript, ONNX, NumPy): by default the closed-loop corrector
     trained in the knee simulator built from spring.json; models on recordings with --model."""
     models = _models(model_text)
@@ -119,7 +121,7 @@ def evaluate(bundles: tuple[str, ...], data: tuple[str, ...], json_path: str | N
 @click.option("--setting", type=click.Choice(["hanging", "ground"]), default="hanging", show_default=True)
 @click.option("--trial-s", type=float, default=10.0, show_default=True, help="trial duration, s")
 @click.option("--seed", type=int, default=0, show_default=True)
-@click.option("--max-seconds", type=float, default=TrainConfig.max_seconds, show_default=True, help="s per round")
+@click.option("--max-seconds", type=float, default=60.0, show_default=True, help="wall-clock cap per round, s")
 @click.option("-o", "--out", "out", type=click.Path(file_okay=False), default=None,
               help="output folder; default exports/<study>/corrector/iterative")
 def iterate(spring_path: str, data: tuple[str, ...], model: str, modalities: str, task: str, positive: bool,

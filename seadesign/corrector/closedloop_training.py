@@ -42,14 +42,15 @@ gait correction's 1-2 (rad/s)^2 at a tenth of the hanging knee's squared error).
 Stop rule: the validation error has not dropped by more than `min_improvement` (1 %) below its best for
 `patience` (4) epochs in a row; each such epoch also multiplies Adam's step size by `lr_decay`. The
 result is the best epoch's policy (epoch 0: the initial one) among epochs whose validation commands rest
-without chatter (`closedloop.chatter_rms` below half the oscillation flag's threshold); `max_epochs` and
-`max_seconds` cap the run. One intra-op thread by default: the batch is small and per-step ops dominate,
+without chatter (`closedloop.chatter_rms` below half the oscillation flag's threshold); `max_epochs` caps the
+run, and `max_seconds` (none by default; `seadesign train` gives one) its wall time. One intra-op thread by default: the batch is small and per-step ops dominate,
 so a second thread only adds synchronisation (measured in docs/validation/timing.md).
 """
 
 from __future__ import annotations
 
 import copy
+import math
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -213,7 +214,7 @@ class ClosedLoopSettings:
     min_improvement: float = 0.01
     patience: int = 4
     max_epochs: int = 60
-    max_seconds: float = 300.0
+    max_seconds: float = math.inf  # none: the run ends on its epochs and patience (the CLI caps it)
     hidden: int = 32
     layers: int = 2
     lipschitz_rad_per_rad: float = FEEDBACK_LIPSCHITZ_RAD_PER_RAD

@@ -45,8 +45,7 @@ class ImitationSettings:
     gait: Gait = Gait()
     ilc: ILCSettings = ILCSettings()
     # one thread: the 3 x 64 network is too small to gain from two, and loses 10x when the CPU is shared
-    train: TrainConfig = field(default_factory=lambda: TrainConfig(model="mlp", batch_size=4096, patience=20,
-                                                                   max_seconds=600.0, threads=1))
+    train: TrainConfig = field(default_factory=lambda: TrainConfig(model="mlp", batch_size=4096, patience=20, threads=1))
     val_every: int = 5
 
     def trials(self) -> list[Trial]:

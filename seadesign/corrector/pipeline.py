@@ -6,14 +6,16 @@ Angles in rad, time in s, torques in Nm.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
 import pandas as pd
 
+from seadesign.corrector.closedloop_training import FINE_TUNING
 from seadesign.corrector.dataset import DatasetSpec
 from seadesign.corrector.export import versions
+from seadesign.corrector.imitation import ImitationSettings
 from seadesign.corrector.iterative import iterate as run_iterations
 from seadesign.corrector.models import MODEL_KINDS
 from seadesign.corrector.preflight import check_spring_range
@@ -29,6 +31,15 @@ from seadesign.twin import thesis_protocol
 
 #: every model `train` knows: the preview models trained in the knee simulator, then those trained on recordings
 TRAIN_KINDS = (*PREVIEW_MODELS, *MODEL_KINDS)
+#: `train`'s wall-clock cap per model (s) by kind when none is given: a network on recordings, the reference
+#: network on ILC labels (also as the closed loop's start), the closed-loop fine-tuning
+CAPS_S = {"network": 60.0, "reference": 600.0, "closedloop": 300.0}
+
+
+def _capped(max_seconds: float) -> ImitationSettings:
+    """The reference network's default settings with its training capped at `max_seconds` (s)."""
+    settings = ImitationSettings()
+    return replace(settings, train=replace(settings.train, max_seconds=max_seconds))
 
 
 @dataclass(frozen=True)
@@ -94,7 +105,7 @@ def train(spring: str | Path, models: str | tuple[str, ...] = "closedloop", data
           modalities: str = "velocity_effort", task: str = "thesis", positive: bool = True, history: int | None = None,
           split: str = "time_blocks", test_recording: tuple[str, ...] = (), seed: int = 0,
           max_epochs: int = TrainConfig.max_epochs, patience: int = TrainConfig.patience,
-          max_seconds: float = TrainConfig.max_seconds, batch_size: int = TrainConfig.batch_size,
+          max_seconds: float | None = None, batch_size: int = TrainConfig.batch_size,
           lr: float = TrainConfig.lr, out: str | Path | None = None,
           echo: Callable[[str], None] | None = None) -> list[TrainedCorrector]:
     """Train corrector network(s) and export each as a bundle (TorchScript, ONNX, NumPy), as `seadesign train`:
@@ -127,8 +138,8 @@ def train(spring: str | Path, models: str | tuple[str, ...] = "closedloop", data
         Seed of the split and the training.
     max_epochs, patience : int
         Epoch cap and early-stopping patience (epochs).
-    max_seconds : float
-        Wall-clock cap per model (s).
+    max_seconds : float, optional
+        Wall-clock cap per model (s); None: each kind's `CAPS_S`.
     batch_size : int
         Samples per step.
     lr : float
@@ -167,7 +178,8 @@ def train(spring: str | Path, models: str | tuple[str, ...] = "closedloop", data
         raise ConfigError(f"models {', '.join(on_data)} are trained on recordings and need data (recording CSVs)")
     data = [str(d) for d in data]
     recs = load_recordings(data) if on_data else []  # the preview models' simulator check reads the files
-    cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=max_seconds,
+    caps = CAPS_S if max_seconds is None else dict.fromkeys(CAPS_S, max_seconds)
+    cfg = TrainConfig(seed=seed, max_epochs=max_epochs, patience=patience, max_seconds=caps["network"],
                       batch_size=batch_size, lr=lr)
     root = Path(out) if out else Path("exports") / doc["study"] / "corrector"
     preview = set(models) & set(PREVIEW_MODELS)
@@ -182,14 +194,16 @@ def train(spring: str | Path, models: str | tuple[str, ...] = "closedloop", data
             folder = {"reference": "reference-ilc", "closedloop": "closedloop"}[model]
             target = root if (out and len(models) == 1) else root / folder
             if model == "reference":
-                path, family1, _ = train_reference_bundle(spring, target, data_paths=data, checks=checks)
+                path, family1, _ = train_reference_bundle(spring, target, _capped(caps["reference"]), data_paths=data,
+                                                          checks=checks)
                 s = family1.summary()["training"]
                 summary = (f"ILC labels {family1.label_s:.0f} s ({len(family1.labels)} batches); best validation MSE "
                            f"{s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} ({s['stopped']}, "
                            f"{s['wall_s']:.1f} s)")
             else:
-                path, res, _ = train_closedloop_bundle(spring, target, family1=family1, data_paths=data,
-                                                       checks=checks)
+                path, res, _ = train_closedloop_bundle(spring, target, replace(FINE_TUNING, max_seconds=caps["closedloop"]),
+                                                       family1=family1, data_paths=data, checks=checks,
+                                                       family1_settings=_capped(caps["reference"]))
                 s = res.summary()
                 summary = (f"fine-tuned through the closed loop: validation mean |Hall error| "
                            f"{s['best_val_mean_abs_error_rad']:.4f} rad at epoch {s['best_epoch']} ({s['stopped']}, "
@@ -259,7 +273,7 @@ def evaluate(bundles: tuple[str | Path, ...], data: tuple[str | Path, ...] = (),
 def iterate_training(spring: str | Path, data: tuple[str | Path, ...] = (), *, model: str = "mlp",
                      modalities: str = "velocity_effort", task: str = "command", positive: bool = True,
                      history: int | None = None, rounds: int = 2, setting: str = "hanging", trial_s: float = 10.0,
-                     seed: int = 0, max_seconds: float = TrainConfig.max_seconds,
+                     seed: int = 0, max_seconds: float = 60.0,
                      out: str | Path | None = None) -> tuple[pd.DataFrame, dict[str, Path]]:
     """Iterative training, as `seadesign iterate`: retrain on simulator runs recorded with the current corrector
     in the loop, and write the table of rounds.

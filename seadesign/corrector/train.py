@@ -7,6 +7,7 @@ not converge within a minute on a CPU; the settings used are stored with every m
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -24,7 +25,8 @@ from seadesign.errors import SeadesignError
 
 @dataclass(frozen=True)
 class TrainConfig:
-    """Training settings. lr in 1/step (Adam), max_seconds is a wall-clock cap in s."""
+    """Training settings. lr in 1/step (Adam); max_seconds is a wall-clock cap in s, none by default, so that a
+    run ends on its epochs and patience and trains the same on every machine (the CLI caps it)."""
 
     model: str = "mlp"
     hidden: int = 64
@@ -36,7 +38,7 @@ class TrainConfig:
     lambda_x: float = 0.1
     weight_decay: float = 0.0
     seed: int = 0
-    max_seconds: float = 60.0
+    max_seconds: float = math.inf
     threads: int = 0  # 0: min(2, cpu count)
     device: str = "auto"
 

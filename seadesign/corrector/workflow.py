@@ -133,14 +133,15 @@ def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
 def train_closedloop_bundle(spring_path: str | Path, out_dir: str | Path, settings: ClosedLoopSettings = FINE_TUNING,
                             family1: ImitationResult | None = None, data_paths: list[str | Path] = (),
                             checks: list[SimulatorCheck] | None = None,
+                            family1_settings: ImitationSettings = ImitationSettings(),
                             ) -> tuple[Path, ClosedLoopResult, list[SimulatorCheck]]:
-    """Family 2, the default corrector: the family-1 network `family1` (trained here with `ImitationSettings()`
+    """Family 2, the default corrector: the family-1 network `family1` (trained here with `family1_settings`
     when None) fine-tuned through the closed loop in the torch knee built from spring.json, exported by
     `export_closedloop_bundle`; meta records family 1's training under "init". The recordings in `data_paths`,
     if any, check that simulator (`simcheck.check_simulator`, unless its `checks` are given; in meta)."""
     spring = load_spring(spring_path)
     checks = check_simulator(spring, list(data_paths)) if checks is None else checks
-    family1 = train_imitation(spring) if family1 is None else family1
+    family1 = train_imitation(spring, family1_settings) if family1 is None else family1
     result = train_closed_loop(spring, settings, family1.training.net)
     meta = {"data": data_record(list(data_paths)), "simulator_check": [c.to_dict() for c in checks],
             "init": {"family1": family1.summary()}}
