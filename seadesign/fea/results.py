@@ -19,11 +19,9 @@ from typing import Any
 
 
 class Scaling(enum.Enum):
-    """How a field follows the torque (or the modulus)."""
-
-    LINEAR = "linear"  # proportional to it (magnitude: torques and moduli are positive)
-    INVERSE = "inverse"  # proportional to its inverse (a safety factor against the torque, a rotation against E)
-    NONE = "none"  # does not depend on it (locations, mesh, timings; k on the torque, stresses on E)
+    LINEAR = "linear"  # proportional to the torque (magnitude: the torques are positive)
+    INVERSE = "inverse"  # proportional to 1 / torque (a safety factor)
+    NONE = "none"  # does not depend on the torque (stiffness, locations, mesh, timings)
 
 
 def linear(modulus: Scaling | None = None) -> Any:
