@@ -7,7 +7,7 @@ import click
 from seadesign.cli import main
 from seadesign.corrector.dataset import TASKS
 from seadesign.corrector.models import MODEL_KINDS
-from seadesign.corrector.pipeline import TRAIN_KINDS, iterate_training
+from seadesign.corrector.pipeline import CAPS_S, TRAIN_KINDS, iterate_training
 from seadesign.corrector.pipeline import evaluate as evaluate_correctors
 from seadesign.corrector.pipeline import train as train_correctors
 from seadesign.corrector.splits import SPLITS
@@ -121,7 +121,8 @@ def evaluate(bundles: tuple[str, ...], data: tuple[str, ...], json_path: str | N
 @click.option("--setting", type=click.Choice(["hanging", "ground"]), default="hanging", show_default=True)
 @click.option("--trial-s", type=float, default=10.0, show_default=True, help="trial duration, s")
 @click.option("--seed", type=int, default=0, show_default=True)
-@click.option("--max-seconds", type=float, default=60.0, show_default=True, help="wall-clock cap per round, s")
+@click.option("--max-seconds", type=float, default=CAPS_S["network"], show_default=True,
+              help="wall-clock cap per round, s")
 @click.option("-o", "--out", "out", type=click.Path(file_okay=False), default=None,
               help="output folder; default exports/<study>/corrector/iterative")
 def iterate(spring_path: str, data: tuple[str, ...], model: str, modalities: str, task: str, positive: bool,

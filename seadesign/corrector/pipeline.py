@@ -273,7 +273,7 @@ def evaluate(bundles: tuple[str | Path, ...], data: tuple[str | Path, ...] = (),
 def iterate_training(spring: str | Path, data: tuple[str | Path, ...] = (), *, model: str = "mlp",
                      modalities: str = "velocity_effort", task: str = "command", positive: bool = True,
                      history: int | None = None, rounds: int = 2, setting: str = "hanging", trial_s: float = 10.0,
-                     seed: int = 0, max_seconds: float = 60.0,
+                     seed: int = 0, max_seconds: float = CAPS_S["network"],
                      out: str | Path | None = None) -> tuple[pd.DataFrame, dict[str, Path]]:
     """Iterative training, as `seadesign iterate`: retrain on simulator runs recorded with the current corrector
     in the loop, and write the table of rounds.
