@@ -103,6 +103,26 @@ def test_real_recordings_train_and_beat_no_correction():
     assert both.loc["mlp", "mae_rad"] < 0.1 * both.loc["none", "mae_rad"]  # measured 1 / 16.2
 
 
+@pytest.mark.parametrize("end_Nm, judged", [(0.05, False), (500.0, True)])
+def test_the_curve_feed_forward_is_scored_only_where_the_curve_reaches_the_recorded_efforts(tmp_path, spring_dict,
+                                                                                        end_Nm, judged):
+    """A network trained on recordings needs only k; the feed-forward baseline that reads the spring's curve is
+    left out of the open-loop table, with the reason, when the recordings' efforts pass the curve's end."""
+    spring = write_spring(_with_curve(spring_dict, end_Nm), tmp_path / "spring.json")
+    csv = _recording(tmp_path, spring_dict)
+    out = tmp_path / "models"
+    assert CliRunner().invoke(main, ["train", "--spring", str(spring), "--data", str(csv), "--model", "mlp",
+                                     "--max-epochs", "2", "-o", str(out)]).exit_code == 0
+    res = CliRunner().invoke(main, ["evaluate", str(out), "--data", str(csv), "--closed-loop", "none", "-o",
+                                    str(tmp_path / "ev"), "--json", str(tmp_path / "ev.json")])
+    assert res.exit_code == 0, res.output
+    result = json.loads((tmp_path / "ev.json").read_text())
+    scored = {r["candidate"] for r in result["open_loop"]}
+    assert ("feedforward" in scored) is judged
+    reason = result["settings"].get("feedforward_not_judged", "")
+    assert judged or f"curve ends at {end_Nm / spring_dict['k_Nm_per_rad']:.4g} rad, {end_Nm:.4g} Nm" in reason
+
+
 def test_the_wall_clock_cap_is_the_cli_s_and_the_library_has_none(tmp_path, spring_dict):
     """`train --max-seconds` stops a network after its first epoch when the cap is already past; without the
     option the CLI caps each kind as `CAPS_S` says, and the library's settings carry no cap at all."""

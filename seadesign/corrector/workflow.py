@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from seadesign.corrector.closedloop import closed_loop_table
-from seadesign.corrector.dataset import CorrectorDataset, DatasetSpec, Recording, build_dataset
+from seadesign.corrector.dataset import KNEES, CorrectorDataset, DatasetSpec, Recording, build_dataset
 from seadesign.corrector.evaluate import open_loop_table
 from seadesign.corrector.closedloop_training import (FINE_TUNING, MEASURED_INPUTS, RATE_TIME_S, ClosedLoopResult,
                                                      ClosedLoopSettings, FlatPolicy, policy_arrays, train_closed_loop)
@@ -33,7 +33,7 @@ from seadesign.corrector.stability import MIN_MODULUS_MARGIN, loop_gain_table
 from seadesign.corrector.splits import Split, make_split
 from seadesign.corrector.train import TrainConfig, TrainResult, fit
 from seadesign.errors import SeadesignError
-from seadesign.design.spring import load_spring, torque_curve
+from seadesign.design.spring import TorqueCurve, load_spring, torque_curve
 from seadesign.twin import KneeConfig, knee_effects, thesis_protocol
 
 DEFAULT_HISTORY = 3  # samples, for the history model when no --history is given
@@ -221,6 +221,19 @@ def evaluation_rows(meta: dict, data_paths: list[str | Path], recs: list[Recordi
         "rows of the recordings not used in training"
 
 
+def _curve_exceeded(curve: TorqueCurve | None, recs: list[Recording]) -> str:
+    """Why the curve-based feed-forward cannot score `recs` (their largest |effort| past the curve's end, which is
+    not extrapolated), or "" when it can."""
+    if curve is None or curve.hard_stop:
+        return ""
+    effort = max(float(np.nanmax(np.abs(r.knees[k]["effort_Nm"]))) for r in recs for k in KNEES)
+    if effort <= curve.end_torque_Nm:
+        return ""
+    return (f"the recordings' efforts reach {effort:.4g} Nm, and the spring's torque curve ends at "
+            f"{curve.end_rotation_rad:.4g} rad, {curve.end_torque_Nm:.4g} Nm (stop reason {curve.stop_reason}; it is "
+            "not extrapolated)")
+
+
 def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path], out_dir: str | Path | None = None,
                      json_path: str | Path | None = None, kp: float = 0.2, ki: float = 0.1,
                      closed_loop: tuple[str, ...] = ("hanging", "ground"), trial_s: float = 10.0,
@@ -256,6 +269,11 @@ def evaluate_bundles(bundle_paths: list[str | Path], data_paths: list[str | Path
         recs = load_recordings(data_paths)
         ds, split, context["rows"] = evaluation_rows(measured[0][2], data_paths, recs)
         ol = [c for c in correctors if not getattr(c, "preview_steps", 0)]
+        beyond = _curve_exceeded(curve, recs)
+        if beyond:  # the curve-based feed-forward cannot follow these efforts: not scored, and said why
+            ol = [c for c in ol if not isinstance(c, FeedForward)]
+            context["not_judged_open_loop"].append("feedforward")
+            context["feedforward_not_judged"] = beyond
         table, traces = open_loop_table(ol, recs, ds, split.test, split.name)
         files = write_table(table, out, "open_loop", context)
         plots = [plot_predictions(traces, out / "predictions_left.png", knee=0),
