@@ -38,13 +38,20 @@ def test_a_field_without_a_rule_is_refused():
         scaled(Forgotten(1.0, 2.0), 3.0)
 
 
-def test_scaled_unit_solve_equals_a_direct_solve(tmp_path):
+@pytest.fixture(scope="module")
+def annulus(tmp_path_factory):
+    """A holed annulus's mesh and its solve at 12 MPa under 11.7 / 27.7 Nm."""
+    solid, ifc = holed_annulus()
+    mesh = mesh_part(solid, ifc, elements_across_beam=1, beam_width_mm=3.0, cache_dir=tmp_path_factory.mktemp("mesh"))
+    return mesh, analyse(mesh, 12e6, 0.48, 4e6, 11.7, 27.7, bearing_radius_mm=9.0).results
+
+
+def test_scaled_unit_solve_equals_a_direct_solve(annulus):
     """The rules applied to a 1 Nm solve give the numbers of a solve at the load torques (every
     column but the timings): a quantity with a wrong rule (say a safety factor declared linear) fails."""
-    solid, ifc = holed_annulus()
-    mesh = mesh_part(solid, ifc, elements_across_beam=1, beam_width_mm=3.0, cache_dir=tmp_path)
+    mesh, solved = annulus
     unit = analyse(mesh, 12e6, 0.48, 4e6, 1.0, 1.0, bearing_radius_mm=9.0).results
-    direct = analyse(mesh, 12e6, 0.48, 4e6, 11.7, 27.7, bearing_radius_mm=9.0).results.columns()
+    direct = solved.columns()
     via_rules = unit.at(11.7, 27.7).columns()
     assert set(via_rules) == set(direct)
     for key, value in direct.items():
@@ -73,13 +80,11 @@ def test_a_field_without_a_modulus_rule_is_refused():
         results_module.with_modulus(Curve(1.0), 2.0)
 
 
-def test_a_solve_at_another_modulus_equals_the_rules(tmp_path):
+def test_a_solve_at_another_modulus_equals_the_rules(annulus):
     """The modulus rules applied to a solve give the numbers of a direct solve at 2.7 times the modulus (the
     same Poisson ratio): k as E, rotations and displacements as 1 / E, stresses and reactions unchanged; a
     quantity with a wrong rule (a stress declared to scale) fails."""
-    solid, ifc = holed_annulus()
-    mesh = mesh_part(solid, ifc, elements_across_beam=1, beam_width_mm=3.0, cache_dir=tmp_path)
-    base = analyse(mesh, 12e6, 0.48, 4e6, 11.7, 27.7, bearing_radius_mm=9.0).results
+    mesh, base = annulus
     direct = analyse(mesh, 2.7 * 12e6, 0.48, 4e6, 11.7, 27.7, bearing_radius_mm=9.0).results.columns()
     via_rules = base.with_modulus(2.7).columns()
     assert via_rules["k_Nm_per_rad"] == pytest.approx(2.7 * base.k_Nm_per_rad, rel=1e-14)
