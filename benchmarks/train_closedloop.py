@@ -32,8 +32,7 @@ from seadesign import __version__
 from seadesign.corrector.closedloop_training import (FINE_TUNING, ClosedLoopResult, ClosedLoopSettings, runtime_corrector,
                                                      train_closed_loop)
 from seadesign.corrector.export import load_meta, load_numpy, load_torchscript
-from seadesign.corrector.imitation import ImitationSettings
-from seadesign.corrector.pipeline import CAPS_S
+from seadesign.corrector.pipeline import CAPS_S, capped_reference_settings
 from seadesign.corrector.reference import Preview
 from seadesign.corrector.runtime import STEP_BUDGET_US
 from seadesign.corrector.workflow import export_closedloop_bundle, train_closedloop_bundle, train_reference_bundle
@@ -118,9 +117,8 @@ def main() -> None:
                 f"{args.threads}; batch {knees} knees (steps/s: samples of the batch)")
     print(settings, flush=True)
     table = Table(COLUMNS)
-    imitation = ImitationSettings()
-    imitation = replace(imitation, train=replace(imitation.train, max_seconds=CAPS_S["reference"]))
-    _, family1, _ = train_reference_bundle(args.spring, args.out / "reference-ilc", imitation)
+    _, family1, _ = train_reference_bundle(args.spring, args.out / "reference-ilc",
+                                           capped_reference_settings(CAPS_S["reference"]))
     family1_s = family1.label_s + family1.training.summary()["wall_s"]
     print(f"family 1: ILC labels {family1.label_s:.1f} s + network {family1.training.summary()['wall_s']:.1f} s = "
           f"{family1_s:.0f} s -> {args.out / 'reference-ilc'}", flush=True)

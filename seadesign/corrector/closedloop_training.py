@@ -43,8 +43,9 @@ Stop rule: the validation error has not dropped by more than `min_improvement` (
 `patience` (4) epochs in a row; each such epoch also multiplies Adam's step size by `lr_decay`. The
 result is the best epoch's policy (epoch 0: the initial one) among epochs whose validation commands rest
 without chatter (`closedloop.chatter_rms` below half the oscillation flag's threshold); `max_epochs` caps the
-run, and `max_seconds` (none by default; `seadesign train` gives one) its wall time. One intra-op thread by default: the batch is small and per-step ops dominate,
-so a second thread only adds synchronisation (measured in docs/validation/timing.md).
+run, and `max_seconds` (none by default; `seadesign train` gives one) its wall time. One intra-op thread by
+default: the batch is small and per-step ops dominate, so a second thread only adds synchronisation
+(measured in docs/validation/timing.md).
 """
 
 from __future__ import annotations

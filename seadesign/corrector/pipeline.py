@@ -36,7 +36,7 @@ TRAIN_KINDS = (*PREVIEW_MODELS, *MODEL_KINDS)
 CAPS_S = {"network": 60.0, "reference": 600.0, "closedloop": 300.0}
 
 
-def _capped(max_seconds: float) -> ImitationSettings:
+def capped_reference_settings(max_seconds: float) -> ImitationSettings:
     """The reference network's default settings with its training capped at `max_seconds` (s)."""
     settings = ImitationSettings()
     return replace(settings, train=replace(settings.train, max_seconds=max_seconds))
@@ -191,19 +191,20 @@ def train(spring: str | Path, models: str | tuple[str, ...] = "closedloop", data
     trained, family1 = [], None
     for model in sorted(models, key=lambda m: m != "reference"):  # family 1 first: family 2 fine-tunes it
         if model in PREVIEW_MODELS:
+            reference = capped_reference_settings(caps["reference"])
             folder = {"reference": "reference-ilc", "closedloop": "closedloop"}[model]
             target = root if (out and len(models) == 1) else root / folder
             if model == "reference":
-                path, family1, _ = train_reference_bundle(spring, target, _capped(caps["reference"]), data_paths=data,
+                path, family1, _ = train_reference_bundle(spring, target, reference, data_paths=data,
                                                           checks=checks)
                 s = family1.summary()["training"]
                 summary = (f"ILC labels {family1.label_s:.0f} s ({len(family1.labels)} batches); best validation MSE "
                            f"{s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} ({s['stopped']}, "
                            f"{s['wall_s']:.1f} s)")
             else:
-                path, res, _ = train_closedloop_bundle(spring, target, replace(FINE_TUNING, max_seconds=caps["closedloop"]),
-                                                       family1=family1, data_paths=data, checks=checks,
-                                                       family1_settings=_capped(caps["reference"]))
+                fine_tuning = replace(FINE_TUNING, max_seconds=caps["closedloop"])
+                path, res, _ = train_closedloop_bundle(spring, target, fine_tuning, family1=family1, data_paths=data,
+                                                       checks=checks, family1_settings=reference)
                 s = res.summary()
                 summary = (f"fine-tuned through the closed loop: validation mean |Hall error| "
                            f"{s['best_val_mean_abs_error_rad']:.4f} rad at epoch {s['best_epoch']} ({s['stopped']}, "
