@@ -31,6 +31,12 @@ def test_import_is_light_and_every_name_resolves():
         sd.sweep_everything  # noqa: B018
 
 
+def test_the_report_only_writes_it_imports_neither_the_fea_nor_the_mesher():
+    code = "import sys, seadesign.report; print(sorted({m.split('.')[1] for m in sys.modules if m.startswith('seadesign.')}))"
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert "'fea'" not in run.stdout and "'mesh'" not in run.stdout and "'report'" in run.stdout
+
+
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
     """(study, root, CLI sweep output folder, CLI output) after one CLI sweep of the tiny study."""

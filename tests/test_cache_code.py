@@ -90,3 +90,18 @@ def test_a_stored_row_is_keyed_on_the_code_that_builds_its_columns(tmp_path, mon
         fingerprint.code_fingerprint.cache_clear()
     assert after[0] != before[0]
     assert after[1] == before[1]
+
+
+def test_one_cache_root_and_the_retired_variable_is_named(tmp_path, monkeypatch):
+    """Stages and meshes share $SEADESIGN_CACHE; the meshes' former variable is refused with the one to set."""
+    from seadesign.errors import ConfigError
+    from seadesign.run.cache import Cache, default_cache
+
+    monkeypatch.delenv("SEADESIGN_CACHE_DIR", raising=False)
+    monkeypatch.setenv("SEADESIGN_CACHE", str(tmp_path / "root"))
+    assert default_cache().root == Cache().root == tmp_path / "root"
+    monkeypatch.setenv("SEADESIGN_CACHE_DIR", str(tmp_path / "old"))
+    with pytest.raises(ConfigError, match=f"SEADESIGN_CACHE_DIR={tmp_path / 'old'} is no longer read.*"
+                                          f"Set SEADESIGN_CACHE={tmp_path / 'old'}"):
+        default_cache()
+    assert default_cache(tmp_path / "given").root == tmp_path / "given"  # an explicit root needs no variable

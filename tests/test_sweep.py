@@ -132,10 +132,10 @@ def test_a_modulus_change_reuses_the_mesh_and_the_linear_solves(tiny, tmp_path):
     study_path, cache_dir, _ = tiny
     s = load_study(study_path)
     base = run_sweep(s, tmp_path / "a", cache=Cache(cache_dir), jobs=1, quiet=True).rows.loc[0]
-    meshes, linear, paths = (set((cache_dir / stage).rglob("*")) for stage in ("mesh", "fea", "path"))
+    meshes, linear, paths = (set((cache_dir / stage).rglob("*")) for stage in ("tetmesh", "fea", "path"))
     stiff = s.with_materials({s.material.key: s.material.scaled(2.0, "test")})
     r = run_sweep(stiff, tmp_path / "b", cache=Cache(cache_dir), jobs=1, quiet=True).rows.loc[0]
-    assert set((cache_dir / "mesh").rglob("*")) == meshes and set((cache_dir / "fea").rglob("*")) == linear
+    assert meshes and set((cache_dir / "tetmesh").rglob("*")) == meshes and set((cache_dir / "fea").rglob("*")) == linear
     assert r["k_Nm_per_rad"] == pytest.approx(2 * base["k_Nm_per_rad"], rel=1e-14)
     assert r["k_coarse_Nm_per_rad"] == pytest.approx(2 * base["k_coarse_Nm_per_rad"], rel=1e-14)
     assert r["stall_rotation_rad"] == pytest.approx(base["stall_rotation_rad"] / 2, rel=1e-14)
@@ -143,28 +143,24 @@ def test_a_modulus_change_reuses_the_mesh_and_the_linear_solves(tiny, tmp_path):
     assert set((cache_dir / "path").rglob("*")) > paths  # the path is solved again
 
 
-def test_warm_rerun_keeps_unchanged_outputs_and_redraws_changed_ones(tiny, tmp_path):
+def test_a_rerun_takes_the_cad_files_from_the_stage_cache(tiny, tmp_path, monkeypatch):
+    """The exported part is a stage of the one cache: a re-run writes the same bytes without exporting the part
+    again, and a new STL tolerance exports it again."""
+    import seadesign.design.export as export
+
     study_path, cache_dir, out = tiny
     folder = out / "tiny"
-    kept = ["pareto.png", "k_vs_beam_count.png", "reaction_displacement.png", "3beams_8mm.stl", "3beams_8mm.step"]
-    before = {n: (folder / n).stat().st_mtime_ns for n in kept}
+    files = ["3beams_8mm.stl", "3beams_8mm.step"]
+    before = {n: (folder / n).read_bytes() for n in files}
+    for n in files:
+        (folder / n).unlink()
+    calls, real = [], export.export_candidate
+    monkeypatch.setattr(export, "export_candidate", lambda *a, **k: calls.append(a) or real(*a, **k))
     args = ["sweep", str(study_path), "--jobs", "1", "--quiet", "--out", str(out), "--cache-dir", str(cache_dir)]
     assert CliRunner().invoke(main, args).exit_code == 0
-    assert {n: (folder / n).stat().st_mtime_ns for n in kept} == before
-    # a heavier stall torque changes the table: the plots are redrawn, the unchanged geometry is not re-exported
-    heavier = write_tiny_study(tmp_path, stall_torque_Nm="23.4")
-    (tmp_path / "exports").mkdir()
-    for n in kept:
-        (tmp_path / "exports" / "tiny").mkdir(exist_ok=True)
-        (tmp_path / "exports" / "tiny" / n).write_bytes((folder / n).read_bytes())
-        (tmp_path / "exports" / "tiny" / f".{n}.key").write_bytes((folder / f".{n}.key").read_bytes())
-    copied = {n: (tmp_path / "exports" / "tiny" / n).stat().st_mtime_ns for n in kept}
-    args = ["sweep", str(heavier), "--jobs", "1", "--quiet", "--out", str(tmp_path / "exports"),
-            "--cache-dir", str(cache_dir)]
-    assert CliRunner().invoke(main, args).exit_code == 0
-    after = {n: (tmp_path / "exports" / "tiny" / n).stat().st_mtime_ns for n in kept}
-    assert all(after[n] != copied[n] for n in kept if n.endswith(".png"))
-    assert all(after[n] == copied[n] for n in kept if not n.endswith(".png"))
+    assert calls == [] and {n: (folder / n).read_bytes() for n in files} == before
+    assert CliRunner().invoke(main, [*args, "--tolerance-mm", "0.05"]).exit_code == 0
+    assert len(calls) == 1 and calls[0][-1] == 0.05
 
 
 def test_failing_candidate_is_recorded_and_the_sweep_goes_on(tmp_path, monkeypatch):

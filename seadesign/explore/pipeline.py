@@ -191,7 +191,6 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
     from seadesign.errors import ConfigError
     from seadesign.explore.loop import LoopSettings
     from seadesign.explore.study_run import explore_study
-    from seadesign.report.exploration import write_exploration
     from seadesign.run.cache import default_cache
     from seadesign.run.executors import default_jobs
     from seadesign.sweep.stages import SolverSettings
@@ -210,11 +209,33 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
     loop = LoopSettings(budget=budget, batch=batch or jobs or default_jobs(), seed=seed)
     run = explore_study(study, folder, loop, solver=solver, cache=cache, executor=executor, jobs=jobs,
                         scheduler=scheduler, quiet=quiet)
-    written = write_exploration(study, run.problem, run.exploration, run.decision, run.sobol, folder, run.settings,
-                                solver=solver, cache=cache, tolerance_mm=tolerance_mm)
+    written = write_exploration_outputs(study, run, folder, solver, cache, tolerance_mm)
     if calibration is not None:
         note += "\n" + uncalibrated_choice_text(study, Path(out_dir) / study.name, run, folder, solver, cache)
     return ExplorationResult(study, run, folder, written, note)
+
+
+def write_exploration_outputs(study: Study, run, folder: Path, solver, cache, tolerance_mm: float) -> dict[str, list[Path]]:
+    """The exploration's tables, figures, render and report (`report.exploration`), and the chosen design's
+    spring.json and CAD files (`sweep.handoff`, `sweep.outputs`); paths by kind."""
+    from seadesign.report.exploration import headline, write_exploration
+    from seadesign.report.explore_plots import column_label
+    from seadesign.sweep.handoff import write_handoff
+    from seadesign.sweep.outputs import chosen_path, export_cad
+
+    decision, evaluated = run.decision, run.exploration.evaluated
+    row = None if decision.index is None else evaluated.loc[decision.index]
+    written = write_exploration(study, run.problem, run.exploration, decision, run.sobol, folder, run.settings,
+                                None if row is None else chosen_path(study, row, solver, cache))
+    if row is not None:
+        objective = run.problem.objectives[0]
+        selection = {"meets_requirements": decision.feasible, "conditional": bool(row["conditional"]),
+                     "failed_constraints": str(row["failed_constraints"]), "not_judged": str(row["not_judged"]),
+                     "deciding_objective": study.requirements.objectives[0], "rank": 1,
+                     "explanation": headline(evaluated, decision, column_label(objective), objective)}
+        written["spring"] = [write_handoff(study, evaluated, row, folder, run.settings, selection)]
+        written["cad"] = export_cad(study, evaluated.loc[[decision.index]], folder, tolerance_mm, cache)
+    return written
 
 
 def uncalibrated_choice_text(study: Study, uncalibrated: Path, run, folder: Path, solver, cache) -> str:

@@ -45,7 +45,7 @@ class SpringProblem:
     study: Study
     out_dir: Path
     settings: SolverSettings = SolverSettings()
-    cache: Cache = Cache()
+    cache: Cache = field(default_factory=Cache)
     executor: str = "local"
     jobs: int | None = None
     scheduler: str | None = None

@@ -44,10 +44,11 @@ def not_judged_reasons(study: Study) -> dict[str, str]:
 
 
 def explore_study(study: Study, out_dir: Path, loop: LoopSettings, *, solver: SolverSettings = SolverSettings(),
-                  cache: Cache = Cache(), executor: str = "local", jobs: int | None = None,
+                  cache: Cache | None = None, executor: str = "local", jobs: int | None = None,
                   scheduler: str | None = None, quiet: bool = False) -> StudyExploration:
     """Explore `study` within `loop.budget` full evaluations (rows stored under `out_dir`, resumable)."""
     t0 = time.perf_counter()
+    cache = cache or Cache()
     display = ProgressDisplay(loop.budget, 0, {}, quiet)
     problem = SpringProblem(study, out_dir, replace(solver, k_error_estimate=False), cache, executor, jobs, scheduler,
                             display)

@@ -5,6 +5,7 @@ Entry point: mesh_part(). Inputs in mm (part coordinates: axis +z, z in [0, thic
 
 from __future__ import annotations
 
+import hashlib
 import json
 import subprocess
 import sys
@@ -15,15 +16,17 @@ from pathlib import Path
 import numpy as np
 
 from seadesign.errors import MeshError
-from seadesign.mesh import cache
 from seadesign.mesh.extrude import layer_count
 from seadesign.mesh.surface import load_stl, tessellate_solid
 from seadesign.mesh.tetmesh import MeshQuality, TetMesh, build_tetmesh
 from seadesign.design.interfaces import Interfaces
+from seadesign.run.cache import default_cache
+from seadesign.run.fingerprint import code_fingerprint
 
 __all__ = ["BACKENDS", "MeshQuality", "TetMesh", "load_stl", "mesh_part"]
 
 BACKENDS = ("gmsh", "pytetwild")
+MESH_STAGE = "tetmesh"  # the stage cache's folder of raw meshes (points_mm, tets)
 REGULAR_TET_VOLUME = 1.0 / (6.0 * np.sqrt(2.0))  # volume of a regular tetrahedron of unit edge
 
 
@@ -78,7 +81,7 @@ def mesh_part(
     "pytetwild" (any closed surface, uniform size; its edge length and envelope are relative to
     the bounding-box diagonal: edge_length_fac = h / diag, epsilon as given). Each attempt runs
     in a child process limited to timeout_s; a failed, timed-out or oversized (> max_tets) attempt is retried `retries` times, then MeshError.
-    Meshes are cached by content under cache_dir (default: cache.default_cache_dir()).
+    Meshes are cached by content in the stage cache rooted at cache_dir (default: `run.cache.default_cache`).
     Its length is the options and this text; the body is five steps (inputs, size check, cache,
     mesh, name the boundaries), each a call.
     """
@@ -98,16 +101,16 @@ def mesh_part(
             f"elements_across_beam={elements_across_beam:g} gives about {estimate:,.0f} tetrahedra, more than "
             f"max_tets={max_tets:,}; use fewer elements across the beam or raise max_tets"
         )
-    cache_dir = Path(cache_dir) if cache_dir is not None else cache.default_cache_dir()
-    key = cache.mesh_key(settings, payload)
-    hit = cache.load(cache_dir, key)
+    cache = default_cache(cache_dir)
+    key = tetmesh_key(settings, payload)
+    hit = cache.get(MESH_STAGE, key)
     attempts: list[str] = []
     t1 = time.perf_counter()
     if hit is not None:
         points, tets = hit
     else:
         points, tets, attempts = _mesh_with_retries(settings, inputs, timeout_s, max_tets, retries, size_mm)
-        cache.store(cache_dir, key, points, tets)
+        cache.put(MESH_STAGE, key, (points, tets))
     info = {
         **settings,
         "elements_across_beam": elements_across_beam,
@@ -120,6 +123,14 @@ def mesh_part(
         "tetrahedralize_s": time.perf_counter() - t1,
     }
     return build_tetmesh(points, tets, interfaces, tag_tol_mm, info)
+
+
+def tetmesh_key(settings: dict, payload: bytes) -> str:
+    """sha256 of the meshing settings, the geometry bytes (tessellation or BREP) and the mesher's code."""
+    h = hashlib.sha256()
+    h.update(json.dumps({"code": code_fingerprint("seadesign.mesh.worker"), **settings}, sort_keys=True).encode())
+    h.update(payload)
+    return h.hexdigest()
 
 
 def _check_options(backend: str, elements_across_beam: float, beam_width_mm: float, layers: int,

@@ -12,15 +12,13 @@ import pandas as pd
 from seadesign.design.study import Study
 from seadesign.explore.decision import Decision
 from seadesign.explore.loop import Exploration
-from seadesign.report import export_cad, write_handoff, write_renders, write_tables
+from seadesign.report import write_renders, write_tables
 from seadesign.report.document import Page, compact_table, fmt, write_html, write_markdown
 from seadesign.report.explore_plots import column_label, fig_history, fig_loo, fig_parallel, fig_sobol
 from seadesign.report.plots import fig_curves
 from seadesign.report.sweep_page import objectives_text, study_text
 from seadesign.run.atomic import atomic_write
-from seadesign.run.cache import Cache
 from seadesign.sweep.requirements import window_verdict
-from seadesign.sweep.stages import SolverSettings
 
 FRONT_SHOWN = 12  # designs in the compact table
 
@@ -70,9 +68,9 @@ def why(t: pd.DataFrame, d: Decision, exploration: Exploration, counts: dict[str
 
 
 def write_exploration(study: Study, problem, exploration: Exploration, decision: Decision, sobol: pd.DataFrame,
-                      folder: Path, settings: dict, *, solver: SolverSettings, cache: Cache,
-                      tolerance_mm: float = 0.01) -> dict[str, list[Path]]:
-    """Write every output of an exploration; returns paths by kind."""
+                      folder: Path, settings: dict, chosen_path=None) -> dict[str, list[Path]]:
+    """Write the tables, figures, render (from the chosen design's path, `sweep.path_stage.PathResponse`) and
+    report of an exploration; returns paths by kind (the table of every design under "tables")."""
     folder.mkdir(parents=True, exist_ok=True)
     xcols = [f"x{i}" for i in range(problem.encoding.dim)]  # the search's unit-cube coordinates: not written
     t = exploration.evaluated.drop(columns=xcols)
@@ -107,13 +105,7 @@ def write_exploration(study: Study, problem, exploration: Exploration, decision:
     renders: dict[str, Path] = {}
     if decision.index is not None:
         row = t.loc[decision.index]
-        renders = write_renders(study, row, folder, solver, cache)
-        selection = {"meets_requirements": decision.feasible, "conditional": bool(row["conditional"]),
-                     "failed_constraints": str(row["failed_constraints"]), "not_judged": str(row["not_judged"]),
-                     "deciding_objective": study.requirements.objectives[0], "rank": 1,
-                     "explanation": headline(t, decision, column_label(objective), objective)}
-        written["spring"] = [write_handoff(study, t, row, folder, settings, selection)]
-        written["cad"] = export_cad(study, t.loc[[decision.index]], folder, tolerance_mm)
+        renders = write_renders(row, chosen_path, folder)
     written["images"] = [*figures.values(), *renders.values()]
     counts = {"full": len(t), "screened": len(screened), "invalid": int((~screened["valid"].astype(bool)).sum())}
     shown = front.sort_values(objective).head(FRONT_SHOWN) if len(front) else front

@@ -17,15 +17,24 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+from seadesign.errors import ConfigError
 from seadesign.run.atomic import atomic_write
 
 
-def _default_cache_dir() -> Path:
-    """$SEADESIGN_CACHE as set now, else ~/.cache/seadesign."""
-    return Path(os.environ.get("SEADESIGN_CACHE", Path.home() / ".cache" / "seadesign"))
+CACHE_ENV = "SEADESIGN_CACHE"  # the one cache root: stages, meshes and exported CAD
+RETIRED_CACHE_ENV = "SEADESIGN_CACHE_DIR"  # the meshes' own root before they joined the stage cache
 
 
-DEFAULT_CACHE_DIR = _default_cache_dir()  # as set when this module was imported; `default_cache` reads it again
+def default_cache_dir() -> Path:
+    """$SEADESIGN_CACHE as set now, else ~/.cache/seadesign; ConfigError while the retired
+    $SEADESIGN_CACHE_DIR is set (it is no longer read, and a silently ignored root would surprise)."""
+    retired = os.environ.get(RETIRED_CACHE_ENV)
+    if retired:
+        raise ConfigError(
+            f"{RETIRED_CACHE_ENV}={retired} is no longer read: meshes now live in the one stage cache. "
+            f"Set {CACHE_ENV}={retired} instead (or unset {RETIRED_CACHE_ENV} to use ~/.cache/seadesign)")
+    return Path(os.environ.get(CACHE_ENV, Path.home() / ".cache" / "seadesign"))
+
 TRACKED_PACKAGES = ("seadesign", "numpy", "scipy", "cadquery", "gmsh", "pytetwild", "mkl")
 
 
@@ -99,7 +108,7 @@ def package_versions(packages: tuple[str, ...] = TRACKED_PACKAGES) -> dict[str, 
 class Cache:
     """Pickled stage outputs under root/<stage>/<key[:2]>/<key>.pkl; `enabled=False` stores nothing."""
 
-    root: Path = DEFAULT_CACHE_DIR
+    root: Path = dataclasses.field(default_factory=default_cache_dir)
     enabled: bool = True
 
     def path(self, stage: str, key: str) -> Path:
@@ -191,4 +200,4 @@ def default_cache(cache_dir: str | Path | None = None) -> Cache:
     >>> default_cache("/tmp/seadesign-cache").root
     PosixPath('/tmp/seadesign-cache')
     """
-    return Cache(Path(cache_dir) if cache_dir else _default_cache_dir())
+    return Cache(Path(cache_dir) if cache_dir else default_cache_dir())

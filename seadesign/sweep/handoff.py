@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from seadesign.design.spring import SCHEMA_VERSION
+from seadesign.design.spring import SCHEMA_VERSION, write_spring
 from seadesign.design.study import Study
+from seadesign.run.cache import digest
 
 def _number(value) -> float | None:
     v = float(value)
@@ -87,3 +89,10 @@ def large_deflection_block(row: pd.Series) -> dict:
             continue
         out[k[len("large_"):]] = v if isinstance(v, str) else bool(v) if isinstance(v, (bool, np.bool_)) else _number(v)
     return out
+
+
+def write_handoff(study: Study, t: pd.DataFrame, row: pd.Series, folder: Path, settings: dict,
+                  selection: dict) -> Path:
+    """spring.json of the chosen row, hashed over every evaluated row and the study's robot data."""
+    inputs_hash = digest("spring", list(t["row_key"]), study.ranking, study.requirements, study.robot, study.actuator)
+    return write_spring(spring_document(study, row, inputs_hash, settings["versions"], selection), folder / "spring.json")

@@ -276,7 +276,7 @@ def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, base
     --------
     >>> result = sweep_and_write(load_study("wolfgang_knee"), "exports", jobs=2)
     """
-    from seadesign.report import write_outputs
+    from seadesign.sweep.outputs import write_outputs
     from seadesign.report.sweep_page import Baseline
 
     cache = default_cache(cache_dir)

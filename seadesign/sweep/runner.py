@@ -133,7 +133,7 @@ def run_sweep(study: Study, out_dir: Path, **options) -> SweepRun:
 
 
 def run_candidates(study: Study, candidates: list[Candidate], out_dir: Path, *, screen: bool = False,
-                   settings: SolverSettings = SolverSettings(), cache: Cache = Cache(), executor: str = "local",
+                   settings: SolverSettings = SolverSettings(), cache: Cache | None = None, executor: str = "local",
                    jobs: int | None = None, scheduler: str | None = None, quiet: bool = False, on_row=None,
                    display: ProgressDisplay | None = None) -> SweepRun:
     """Evaluate `candidates` (reusing stored rows with unchanged inputs; rows in `<out>/rows/`, screening rows,
@@ -141,6 +141,7 @@ def run_candidates(study: Study, candidates: list[Candidate], out_dir: Path, *, 
     computed row is stored (progress hooks, tests); `display` is a progress display the caller keeps across
     calls (one per call by default)."""
     t0 = time.perf_counter()
+    cache = cache or Cache()
     rows_dir = Path(out_dir) / ("screen" if screen else "rows")
     keys = [screen_key(study, c) if screen else row_key(study, c, settings) for c in candidates]
     rows: dict[int, dict] = {}

@@ -22,7 +22,6 @@ from __future__ import annotations
 import functools
 import time
 from dataclasses import dataclass, replace
-from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
 
@@ -117,7 +116,7 @@ def check_geometry(study: Study, candidate: Candidate, cache: Cache) -> tuple[Ca
 def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache, coarsening: float = 1.0,
                    layers: int | None = None):
     """Tetrahedral mesh (mm) of a built part with named interface boundaries (mesh package,
-    its own content-addressed cache under the sweep cache's root); `coarsening` > 1 makes the
+    its raw meshes in the same stage cache); `coarsening` > 1 makes the
     elements that many times longer (beam, curvature and layer sizing alike); `layers` replaces the
     study's layers through a prismatic part's thickness."""
     from seadesign.mesh import mesh_part
@@ -126,7 +125,7 @@ def tetrahedralize(study: Study, candidate: Candidate, part: Part, cache: Cache,
     if layers is not None:
         options["layers"] = layers
     return mesh_part(part.solid, part.interfaces, beam_width_mm=candidate.params.beam_thickness_mm,
-                     cache_dir=Path(cache.root) / "mesh", **options)
+                     cache_dir=cache.root, **options)
 
 
 def unit_response(mesh, study: Study, candidate: Candidate, settings: SolverSettings) -> UnitResponse:
