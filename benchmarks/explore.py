@@ -20,7 +20,7 @@ import tempfile
 from pathlib import Path
 
 from seadesign.design.study import load_study
-from seadesign.explore.loop import LoopSettings
+from seadesign.explore.explorer import ExplorerSettings
 from seadesign.explore.study_run import explore_study
 from seadesign.run.cache import Cache
 from seadesign.run.executors import default_jobs
@@ -46,7 +46,7 @@ def main() -> None:
     if args.layers is not None:
         mesh = dataclasses.replace(mesh, layers=args.layers)
     study = dataclasses.replace(study, mesh=mesh)
-    loop = LoopSettings(budget=args.budget, batch=args.jobs, seed=args.seed)
+    loop = ExplorerSettings(budget=args.budget, batch=args.jobs, seed=args.seed)
     solver = SolverSettings()
     with tempfile.TemporaryDirectory(prefix="seadesign-explore-") as tmp:
         cache = Cache(args.cache_dir or Path(tmp) / "cache")

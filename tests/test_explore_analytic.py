@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from helpers_analytic import BNH, TNK, StripedBNH, igd
-from seadesign.explore.loop import LoopSettings, explore
+from seadesign.explore.explorer import ExplorerSettings, explore
 
 
 # both (BNH about 55 s, TNK about 80 s) run with the slow tests, to keep the default run under 15 minutes; CI runs both
@@ -25,7 +25,7 @@ from seadesign.explore.loop import LoopSettings, explore
                          ids=["BNH", "TNK"])
 def test_explorer_finds_the_known_front_within_budget(problem, budget, threshold):
     p = problem()
-    result = explore(p, LoopSettings(budget=budget, batch=4, seed=0, patience=100))
+    result = explore(p, ExplorerSettings(budget=budget, batch=4, seed=0, patience=100))
     t = result.evaluated
     assert p.evaluations == len(t) <= budget
     front = t[t["front"]]
@@ -38,7 +38,7 @@ def test_explorer_finds_the_known_front_within_budget(problem, budget, threshold
 @pytest.mark.slow  # 32 s: the default run was 13 min 53 s to 15 min 51 s on the 2-core machine (budget 15 min)
 def test_surrogates_fitted_in_two_processes_take_the_same_route():
     """The fits are independent and seeded: two processes give the same models, so the same designs."""
-    tables = [explore(BNH(), LoopSettings(budget=14, batch=2, seed=0, patience=100), jobs=jobs).evaluated
+    tables = [explore(BNH(), ExplorerSettings(budget=14, batch=2, seed=0, patience=100), jobs=jobs).evaluated
               for jobs in (1, 2)]
     assert tables[0].equals(tables[1])
 
@@ -46,7 +46,7 @@ def test_surrogates_fitted_in_two_processes_take_the_same_route():
 def test_a_round_replaces_proposals_that_screen_invalid_and_verifies_a_full_batch():
     """Where designs cannot be built, proposals screen invalid; each round replaces them from the search's
     spares, so every round but the last (the budget's remainder) verifies the whole batch."""
-    result = explore(StripedBNH(), LoopSettings(budget=24, batch=3, seed=0, patience=100))
+    result = explore(StripedBNH(), ExplorerSettings(budget=24, batch=3, seed=0, patience=100))
     screened, evaluated = result.screened, result.evaluated
     searched = screened[screened["round"] > 0]
     assert (~searched["valid"].astype(bool)).sum() >= 6  # the stripes were proposed: the case was exercised

@@ -9,7 +9,7 @@ import re
 import pytest
 
 from seadesign.design.study import load_study
-from seadesign.explore.loop import LoopSettings, explore
+from seadesign.explore.explorer import ExplorerSettings, explore
 from seadesign.explore.spring_problem import SpringProblem
 from seadesign.run.cache import Cache
 from seadesign.sweep.rank import rank
@@ -31,7 +31,7 @@ def test_a_continuous_thickness_beats_every_grid_point(tmp_path):
     cache = Cache(tmp_path / "cache")
     ranked, _ = rank(run_sweep(grid, tmp_path / "grid", cache=cache, jobs=2, quiet=True).rows, grid)
     assert (ranked["status"] == "ok").all()
-    result = explore(SpringProblem(opened, tmp_path / "open", cache=cache, jobs=2), LoopSettings(budget=8, batch=2))
+    result = explore(SpringProblem(opened, tmp_path / "open", cache=cache, jobs=2), ExplorerSettings(budget=8, batch=2))
     t = result.evaluated
     best = t.loc[result.best]
     assert best["thickness_mm"] != GRID_THICKNESS_MM  # off the grid

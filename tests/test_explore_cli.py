@@ -44,7 +44,7 @@ def test_explore_command(tmp_path):
                  "torque_curves.png", "3beams_8mm.stl", "3beams_8mm.step", "report.md"):
         assert (folder / name).is_file(), name
     settings = json.loads((folder / "settings.json").read_text())
-    assert settings["loop"]["budget"] == 2 and settings["solver"]["k_error_estimate"] == "the reported design only"
+    assert settings["explorer"]["budget"] == 2 and settings["solver"]["k_error_estimate"] == "the reported design only"
     assert f"study {study} (sha256 {settings['files']['study']['sha256']})" in (folder / "report.md").read_text()
     seen = assert_readable(folder / "report.html")
     assert seen["decision"]["text"].startswith("No solved design meets every requirement. The nearest, 3 beams x 8 mm")

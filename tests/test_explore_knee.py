@@ -10,7 +10,7 @@ import dataclasses
 import pytest
 
 from seadesign.design.study import load_study
-from seadesign.explore.loop import LoopSettings
+from seadesign.explore.explorer import ExplorerSettings
 from seadesign.explore.study_run import explore_study
 from seadesign.run.cache import Cache
 
@@ -22,7 +22,7 @@ def test_a_reduced_knee_exploration_runs_search_rounds_and_never_calls_a_conditi
     study = dataclasses.replace(study, mesh=coarse)
     # most of this space cannot be built (the knee run screened 89 of 115 invalid): room for 20 screenings per
     # evaluation, so that the small budget reaches the search rounds
-    loop = LoopSettings(budget=8, batch=2, seed=0, screen_factor=20)
+    loop = ExplorerSettings(budget=8, batch=2, seed=0, screen_factor=20)
     run = explore_study(study, tmp_path / "out", loop, cache=Cache(tmp_path / "c"), jobs=2, quiet=True)
     t = run.exploration.evaluated
     searched = [r for r in run.exploration.rounds if r.index > 0]

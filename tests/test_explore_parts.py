@@ -1,6 +1,7 @@
 """The explorer's parts against independent references: the axes' unit cube, the design of experiments,
 the surrogates' leave-one-out error against refitting without each point, the feasibility classifier on a
-known boundary, and Sobol indices of a function whose indices are known in closed form."""
+known boundary, Sobol indices of a function whose indices are known in closed form, and the stop rules and
+ask/tell of the explorer."""
 
 from __future__ import annotations
 
@@ -11,8 +12,10 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from seadesign.design.space import Axis
 from seadesign.explore.doe import initial_design
 from seadesign.explore.encoding import Encoding
+from seadesign.explore.explorer import Explorer, ExplorerSettings
 from seadesign.explore.models import Models
 from seadesign.explore.sensitivity import sobol_indices
+from seadesign.explore.stopping import EvaluationBudget, Progress, first_reason
 from seadesign.explore.surrogate import FeasibilityClassifier, Surrogate
 
 AXES = (Axis("thickness_mm", bounds=(6.0, 20.0)), Axis("beam_count", (3, 4, 6, 10)),
@@ -78,3 +81,29 @@ def test_sobol_indices_of_an_additive_function():
     idx = sobol_indices(enc, models, ["f"], seed=0).set_index("axis")
     assert idx.loc["a", "S1"] == pytest.approx(0.2, abs=0.05) and idx.loc["b", "S1"] == pytest.approx(0.8, abs=0.05)
     assert idx.loc["a", "ST"] == pytest.approx(0.2, abs=0.05) and idx.loc["b", "ST"] == pytest.approx(0.8, abs=0.05)
+
+
+def test_the_stop_rules_compose_and_the_first_that_fires_names_the_stop():
+    rules = ExplorerSettings(budget=10, patience=2, screen_factor=3).stop_rules()
+    assert first_reason(rules, Progress(9, 29, 1, False)) is None
+    assert first_reason(rules, Progress(10, 0, 0, False)) == "budget spent"
+    assert first_reason(rules, Progress(10, 0, 2, False)) == "the front did not move in 2 rounds"
+    assert first_reason(rules, Progress(5, 30, 0, False)) is None  # screenings spent, but the round found designs
+    assert first_reason(rules, Progress(5, 30, 0, True)) == "the screening budget is spent"
+    assert first_reason((), Progress(10, 30, 5, True)) is None
+
+
+def test_ask_and_tell_stop_on_the_callers_rule():
+    """The caller drives the explorer and replaces its stop rules: it stops after the round that reaches 7
+    evaluations, though the settings' budget allows 20, and asks nothing more."""
+    from helpers_analytic import BNH
+
+    problem = BNH()
+    explorer = Explorer(problem, ExplorerSettings(budget=20, batch=2, seed=0, patience=100), rules=(EvaluationBudget(7),))
+    told = []
+    while (X := explorer.ask()) is not None:
+        explorer.tell(X, problem.evaluate(X))
+        told.append(len(X))
+    assert explorer.stop_reason == "budget spent" and explorer.ask() is None
+    assert sum(told[:-1]) < 7 <= sum(told) == problem.evaluations == len(explorer.result().evaluated) < 20
+    assert all(n <= 2 for n in told[1:])  # after the initial design, one batch a round

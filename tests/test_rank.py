@@ -26,6 +26,17 @@ def test_pareto_front_of_a_known_set():
     assert pareto_front(obj).tolist() == [True, True, True, False, False]
 
 
+def test_pareto_front_is_the_definition_of_domination_with_ties():
+    """Against the definition written out (a row is dominated by one no worse in every objective and better in
+    one), on random sets with many equal values: equal rows do not dominate each other."""
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        obj = rng.integers(0, 4, (int(rng.integers(1, 25)), int(rng.integers(1, 4)))).astype(float)
+        dominated = [(np.all(obj <= f, axis=1) & np.any(obj < f, axis=1)).any() for f in obj]
+        assert pareto_front(obj).tolist() == [not d for d in dominated]
+    assert pareto_front(np.empty((0, 2))).tolist() == []
+
+
 ROWS = [  # name, k (Nm/rad), tensile strain per rad, stop torque (Nm; None: the impact torque), mass (g)
     ("A", 20.0, 0.2, None, 30.0),  # stall strain 0.117 of 0.2 cyclic; impact 0.277 of 0.433: feasible, softest
     ("B", 30.0, 0.2, None, 25.0),
@@ -176,7 +187,7 @@ def test_the_standing_verdict_says_where_a_path_ends_below_the_standing_torque()
     import pandas as pd
 
     from seadesign.design.study import load_study
-    from seadesign.sweep.rank import standing_verdict
+    from seadesign.report.verdicts import standing_verdict
 
     study = load_study()
     ranked = pd.DataFrame({"candidate": ["short", "long"], "k_Nm_per_rad": [8.02, 30.0],

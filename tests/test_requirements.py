@@ -13,7 +13,8 @@ import pytest
 from helpers_curves import linear_row, with_limits
 from seadesign.design.study import DEFAULT_STUDY, load_study
 from seadesign.errors import ConfigError
-from seadesign.sweep.rank import constraint_columns, physical_columns
+from seadesign.sweep.physical import physical_columns
+from seadesign.sweep.rank import constraint_columns
 from seadesign.sweep.requirements import STRAIN_TORQUE_KNOCKDOWN, working_tangents
 
 KNEE_REQUIREMENTS = re.compile(r"(?ms)^\[requirements\].*\Z")  # the default study's table, its last

@@ -17,7 +17,7 @@ import numpy as np
 
 from seadesign.explore.doe import pool
 from seadesign.explore.encoding import Encoding
-from seadesign.explore.loop import Exploration
+from seadesign.explore.explorer import Exploration
 from seadesign.explore.search import surrogate_optimum
 
 ACTIVE_MARGIN = 0.05  # met with less than 5 % of its limit to spare: the requirement is active

@@ -189,7 +189,7 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
     >>> result.plot()
     """
     from seadesign.errors import ConfigError
-    from seadesign.explore.loop import LoopSettings
+    from seadesign.explore.explorer import ExplorerSettings
     from seadesign.explore.study_run import explore_study
     from seadesign.run.cache import default_cache
     from seadesign.run.executors import default_jobs
@@ -206,8 +206,8 @@ def run_exploration(study: str | Path | Study, budget: int = 80, *, batch: int |
     cache = default_cache(cache_dir)
     solver = SolverSettings()
     folder = Path(out_dir) / (f"{study.name}-calibrated" if calibration is not None else study.name)
-    loop = LoopSettings(budget=budget, batch=batch or jobs or default_jobs(), seed=seed)
-    run = explore_study(study, folder, loop, solver=solver, cache=cache, executor=executor, jobs=jobs,
+    explorer = ExplorerSettings(budget=budget, batch=batch or jobs or default_jobs(), seed=seed)
+    run = explore_study(study, folder, explorer, solver=solver, cache=cache, executor=executor, jobs=jobs,
                         scheduler=scheduler, quiet=quiet)
     written = write_exploration_outputs(study, run, folder, solver, cache, tolerance_mm)
     if calibration is not None:

@@ -12,7 +12,7 @@ final population the designs to verify are, in order:
 4. the rest of the batch (at least one pick of a batch of two or more while nothing is predicted
    feasible): the designs most likely to be feasible over a space-filling sample, the margins'
    uncertainty included, so the search also looks where the surrogates are unsure.
-After the batch come `spare` further designs of step 4, in order: the loop screens them when proposals of the
+After the batch come `spare` further designs of step 4, in order: the explorer screens them when proposals of the
 batch screen invalid, so that a round still verifies a full batch (a core is not left idle for a round).
 Designs already screened (verified, or found invalid) are never proposed again.
 """

@@ -25,7 +25,8 @@ from seadesign.explore.encoding import Encoding
 from seadesign.explore.problem import SOLVED, VALID
 from seadesign.run.cache import Cache
 from seadesign.run.progress import ProgressDisplay
-from seadesign.sweep.rank import constraint_columns, physical_columns
+from seadesign.sweep.physical import physical_columns
+from seadesign.sweep.rank import constraint_columns
 from seadesign.sweep.requirements import LOAD_CLASS, OBJECTIVE_COLUMNS, USABLE, envelope, lacks_limit, requirement_list
 from seadesign.sweep.runner import run_candidates
 from seadesign.sweep.stages import SolverSettings

@@ -1,4 +1,4 @@
-"""A study explored end to end (without writing): the spring problem, the loop, the decision, the Sobol
+"""A study explored end to end (without writing): the spring problem, the explorer, the decision, the Sobol
 indices and the settings to record with the results."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import pandas as pd
 
 from seadesign.design.study import Study
 from seadesign.explore.decision import Decision, decide
-from seadesign.explore.loop import Exploration, LoopSettings, explore
+from seadesign.explore.explorer import Exploration, ExplorerSettings, explore
 from seadesign.explore.sensitivity import sobol_indices
 from seadesign.explore.spring_problem import SpringProblem
 from seadesign.run.cache import Cache
@@ -29,7 +29,7 @@ class StudyExploration:
     exploration: Exploration
     decision: Decision
     sobol: pd.DataFrame
-    settings: dict  # recorded with the results (study, solver, loop, versions)
+    settings: dict  # recorded with the results (study, solver, explorer, versions)
     wall_s: float
 
 
@@ -43,27 +43,27 @@ def not_judged_reasons(study: Study) -> dict[str, str]:
     return out
 
 
-def explore_study(study: Study, out_dir: Path, loop: LoopSettings, *, solver: SolverSettings = SolverSettings(),
+def explore_study(study: Study, out_dir: Path, explorer: ExplorerSettings, *, solver: SolverSettings = SolverSettings(),
                   cache: Cache | None = None, executor: str = "local", jobs: int | None = None,
                   scheduler: str | None = None, quiet: bool = False) -> StudyExploration:
-    """Explore `study` within `loop.budget` full evaluations (rows stored under `out_dir`, resumable)."""
+    """Explore `study` within `explorer.budget` full evaluations (rows stored under `out_dir`, resumable)."""
     t0 = time.perf_counter()
     cache = cache or Cache()
-    display = ProgressDisplay(loop.budget, 0, {}, quiet)
+    display = ProgressDisplay(explorer.budget, 0, {}, quiet)
     problem = SpringProblem(study, out_dir, replace(solver, k_error_estimate=False), cache, executor, jobs, scheduler,
                             display)
     with keeping_workers():
-        exploration = explore(problem, loop, jobs or default_jobs())
+        exploration = explore(problem, explorer, jobs or default_jobs())
     display.close()
     words = {r.column: r.words for r in requirement_list(study)}
     decision = decide(exploration, problem.encoding, words, not_judged_reasons(study),
-                      OBJECTIVE_WORDS[study.requirements.objectives[0]], loop.seed)
+                      OBJECTIVE_WORDS[study.requirements.objectives[0]], explorer.seed)
     if decision.index is not None and solver.k_error_estimate:
         estimate_k_error(problem, exploration.evaluated, decision.index, solver)
-    sobol = sobol_indices(problem.encoding, exploration.models, problem.outputs, loop.seed)
+    sobol = sobol_indices(problem.encoding, exploration.models, problem.outputs, explorer.seed)
     settings = sweep_settings(study, problem.settings)
     settings["solver"]["k_error_estimate"] = "the reported design only" if solver.k_error_estimate else False
-    settings.update(requirements=asdict(study.requirements), loop=asdict(loop))
+    settings.update(requirements=asdict(study.requirements), explorer=asdict(explorer))
     return StudyExploration(problem, exploration, decision, sobol, settings, time.perf_counter() - t0)
 
 

@@ -11,7 +11,7 @@ import pandas as pd
 
 from seadesign.design.study import Study
 from seadesign.explore.decision import Decision
-from seadesign.explore.loop import Exploration
+from seadesign.explore.explorer import Exploration
 from seadesign.report import write_renders, write_tables
 from seadesign.report.document import Page, compact_table, fmt, write_html, write_markdown
 from seadesign.report.explore_plots import column_label, fig_history, fig_loo, fig_parallel, fig_sobol

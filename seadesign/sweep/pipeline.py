@@ -17,7 +17,7 @@ from seadesign.design.materials import Hyperelastic
 from seadesign.design.study import DEFAULT_STUDY, Study, load_study
 from seadesign.errors import ConfigError
 from seadesign.run.cache import default_cache
-from seadesign.sweep.rank import Choice, calibration_summary, handoff_verdict, rank
+from seadesign.sweep.rank import Choice, rank
 from seadesign.sweep.runner import SweepRun, run_sweep, sweep_settings
 from seadesign.sweep.stages import SolverSettings
 
@@ -174,6 +174,8 @@ class SweepResult:
         --------
         >>> print("\\n".join(result.lines(quiet=True)))
         """
+        from seadesign.report.verdicts import handoff_verdict
+
         counts = self.ranked["status"].value_counts().to_dict()
         out = [f"{len(self.ranked)} candidates ({', '.join(f'{n} {k}' for k, n in counts.items())}); "
                f"{len(self.run.computed)} computed, {len(self.run.reused)} reused, {self.run.wall_s:.1f} s",
@@ -276,8 +278,9 @@ def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, base
     --------
     >>> result = sweep_and_write(load_study("wolfgang_knee"), "exports", jobs=2)
     """
-    from seadesign.sweep.outputs import write_outputs
     from seadesign.report.sweep_page import Baseline
+    from seadesign.report.verdicts import calibration_summary
+    from seadesign.sweep.outputs import write_outputs
 
     cache = default_cache(cache_dir)
     solver = SolverSettings()

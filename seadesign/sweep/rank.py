@@ -7,15 +7,8 @@ the table for comparison with the thesis.
 Objectives (all minimised; `sweep/requirements.py: OBJECTIVE_COLUMNS`): mass; accuracy, the arc the bearing
 circle turns through at the stall torque; gearbox protection, the peak torque a foot strike drives into the
 gearbox; strain_margin, the largest share of a load's strain limit used; softest_k, the small-load k. The
-first objective of `[requirements] objectives` decides among feasible designs, mass breaks ties.
-
-Protection: the leg (inertia J about the knee, angular speed w = v / lower_leg at touchdown) is
-stopped by the spring with the gearbox side held: its kinetic energy J w^2 / 2 goes into the
-spring, int_0^theta T dtheta, and the torque where the curve has stored it is the peak. (A linear
-spring gives tau_peak = w sqrt(k J).) A curve that ends before it has stored that energy gives
-no number: the strike reaches the path's stop. A static reaction force cannot measure protection:
-in statics the whole applied torque reaches the motor whatever k is (the thesis's 149-150 N for
-every design).
+first objective of `[requirements] objectives` decides among feasible designs, mass breaks ties. The physical
+columns these read are `sweep.physical`'s.
 
 Feasible: valid geometry, solved, and every requirement judged and met. A design that meets every judged
 requirement but has some that cannot be judged (a strain limit the material file does not source) is
@@ -25,19 +18,16 @@ must reach.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
+from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from seadesign.constants import THESIS_FEA_RESULTS
-from seadesign.design.spring import TorqueCurve
 from seadesign.design.study import Study
-from seadesign.sweep.handoff import curve_to_stop
-from seadesign.sweep.requirements import (OBJECTIVE_COLUMNS, OBJECTIVE_WORDS, PROTECTION, STRAIN_USE, USABLE, margins,
-                                          limit_torque, not_judged, requirement_list, strain_use, total_violation,
-                                          working_range)
+from seadesign.sweep.physical import physical_columns
+from seadesign.sweep.requirements import (OBJECTIVE_COLUMNS, OBJECTIVE_WORDS, USABLE, margins, not_judged,
+                                          requirement_list, total_violation)
 
 
 @dataclass(frozen=True)
@@ -52,49 +42,13 @@ class Choice:
 
 
 def pareto_front(objectives: np.ndarray) -> np.ndarray:
-    """Mask of the non-dominated rows of an (n, m) array, all objectives minimised."""
+    """Mask of the non-dominated rows of an (n, m) array, all objectives minimised (pymoo's non-dominated
+    sorting, the one domination test of the sweep and the explorer: equal rows do not dominate each other)."""
     obj = np.asarray(objectives, dtype=float)
-    mask = np.ones(len(obj), dtype=bool)
-    for i in range(len(obj)):
-        dominated = np.all(obj <= obj[i], axis=1) & np.any(obj < obj[i], axis=1)
-        mask[i] = not dominated.any()
+    mask = np.zeros(len(obj), dtype=bool)
+    if len(obj):
+        mask[NonDominatedSorting().do(obj, only_non_dominated_front=True)] = True
     return mask
-
-
-def physical_columns(table: pd.DataFrame, study: Study) -> pd.DataFrame:
-    """Standing deflection, foot error at stall, impact energy, gearbox strike torque and the energy the curve
-    stores to its stop, the working range's tangents, natural frequency and torque per sensor count, the
-    usable torque (the smaller of where the path stops and where the tensile strain passes the cyclic limit),
-    the share of the strain limits used, thesis numbers."""
-    rk, robot = study.ranking, study.robot
-    t = table.copy()
-    energy = 0.5 * rk.knee_inertia_kg_m2 * study.strike_speed_rad_per_s ** 2
-    solved = t["status"] == "ok"
-    t["standing_knee_torque_Nm"] = robot.standing_knee_torque_Nm
-    t["standing_deflection_deg"] = np.degrees(t["large_standing_rotation_rad"]) if "large_standing_rotation_rad" in t \
-        else np.nan
-    t["stall_foot_error_mm"] = t["large_stall_rotation_rad"] * robot.lower_leg_m * 1e3 if "large_stall_rotation_rad" \
-        in t else np.nan
-    t["strike_energy_J"] = energy
-    if "large_stop_torque_Nm" in t:
-        t[USABLE] = pd.concat([t["large_stop_torque_Nm"], limit_torque(t, "cyclic")], axis=1).min(axis=1, skipna=True)
-    curves = [TorqueCurve(*map(tuple, curve_to_stop(r))) if ok else None for ok, (_, r) in zip(solved, t.iterrows())]
-    t["large_stop_energy_J"] = [np.nan if c is None else c.energy_J for c in curves]
-    t[PROTECTION] = np.array([None if c is None else c.torque_at_energy(energy) for c in curves], dtype=float)
-    t = pd.concat([t.drop(columns=[c for c in ("working_min_tangent_k_Nm_per_rad", "working_max_tangent_k_Nm_per_rad",
-                                               "natural_frequency_Hz", "torque_per_count_Nm") if c in t]),
-                   working_range(t, study)], axis=1)
-    t[STRAIN_USE] = strain_use(t, study)
-    thesis = [_thesis_result(study, row) for _, row in t.iterrows()]
-    t["thesis_reaction_N"] = [r for r, _ in thesis]
-    t["thesis_displacement_mm"] = [d for _, d in thesis]
-    return t
-
-
-def _thesis_result(study: Study, row: pd.Series) -> tuple[float, float]:
-    """The thesis's (reaction N, displacement mm) for the row's beam count and thickness, when it reports them."""
-    p = study.candidate_of_row(row).params
-    return THESIS_FEA_RESULTS.get((p.beam_count, p.beam_thickness_mm), (math.nan, math.nan))
 
 
 def constraint_columns(t: pd.DataFrame, study: Study) -> pd.DataFrame:
@@ -187,16 +141,6 @@ def explain(t: pd.DataFrame, choice: Choice, study: Study) -> str:
     return text
 
 
-def handoff_verdict(t: pd.DataFrame, choice: Choice) -> str:
-    """Whether the spring handed on meets the requirements, in one line."""
-    row = t.loc[choice.index]
-    if choice.feasible:
-        return f"{row['candidate']} meets every requirement, each judged"
-    if choice.conditional:
-        return f"{row['candidate']} meets every judged requirement; not judged: {row['not_judged']}"
-    return f"{row['candidate']} does NOT meet the requirements (misses: {row['failed_constraints']})"
-
-
 def blocking(row: pd.Series, study: Study) -> str:
     """The requirements a design misses, each with the fraction it misses by, the worst first."""
     missed = [(float(row[r.column]), r.words) for r in requirement_list(study)
@@ -222,35 +166,3 @@ def unblock(row: pd.Series, study: Study) -> str:
     if row.get("not_judged"):
         hints.append("a material with a sourced value for each missing datum")
     return ("What would unblock it: " + "; ".join(hints) + ".") if hints else ""
-
-
-def standing_verdict(ranked: pd.DataFrame, candidate: str, study: Study) -> str:
-    """Whether `candidate` carries the robot's standing load in `ranked` (deflection vs the limit, deg)."""
-    row = ranked.loc[ranked["candidate"] == candidate].iloc[0]
-    limit = study.requirements.max_standing_deflection_deg
-    deg = float(row["standing_deflection_deg"])
-    if limit is None:
-        verdict, limit_words = ("carries" if np.isfinite(deg) else "does NOT carry"), "no sag limit"
-    else:
-        verdict, limit_words = ("carries" if deg < limit else "does NOT carry"), f"limit {limit:g} deg"
-    if not np.isfinite(deg):  # the path ends below the standing torque: no deflection to judge
-        return (f"{candidate}: k {row['k_Nm_per_rad']:.4g} Nm/rad, its path ends at {row['large_stop_torque_Nm']:.3g} "
-                f"Nm ({row['large_stop_reason']}), below the standing torque {row['standing_knee_torque_Nm']:.3g} Nm: "
-                "does NOT carry the standing load")
-    return (f"{candidate}: k {row['k_Nm_per_rad']:.4g} Nm/rad, standing deflection {deg:.3g} deg under "
-            f"{row['standing_knee_torque_Nm']:.3g} Nm ({limit_words}): {verdict} the standing load")
-
-
-def calibration_summary(base: pd.DataFrame, base_choice: Choice, calibrated: pd.DataFrame, choice: Choice,
-                        study: Study) -> str:
-    """Lines comparing the choice before and after calibration, each judged with the calibrated material."""
-    if base_choice.index is None or choice.index is None:
-        return "calibration: no candidate was solved, nothing to compare"
-    before, after = base.loc[base_choice.index, "candidate"], calibrated.loc[choice.index, "candidate"]
-    lines = [f"calibration: choice {'unchanged' if before == after else 'changes'}: {before} -> {after}",
-             "  uncalibrated choice, calibrated material: " + standing_verdict(calibrated, before, study)]
-    if after != before:
-        lines.append("  calibrated choice: " + standing_verdict(calibrated, after, study))
-    if not choice.feasible:
-        lines.append("  no candidate meets every constraint with the calibrated material; see the report")
-    return "\n".join(lines)

@@ -7,7 +7,7 @@ for a load's class has no allowable strain there. A requirement that cannot be j
 (`rank.constraint_columns`); `not_judged` says which datum is missing and the value it must reach. The
 margins are continuous across each limit, so the explorer can model them and add the misses up
 (`total_violation`). Everything but the explicit k range is read from the large-deflection path (`large_`
-columns; `rank.physical_columns`); that range bounds the small-load k, which the linear solve gives on the
+columns; `physical.physical_columns`); that range bounds the small-load k, which the linear solve gives on the
 finer result mesh (the path's tangent at rest equals it on the same mesh).
 
 Per requirement (T: the load's torque; travel: the torque where the path stops; the working range: rest to
@@ -152,7 +152,7 @@ def _strike_margin(t: pd.DataFrame, limit_Nm: float) -> pd.Series:
 
 def margins(t: pd.DataFrame, study: Study) -> pd.DataFrame:
     """One margin column per requirement (`requirement_list`) for every row; NaN where not solved or not
-    judged. `t` has the physical columns (`rank.physical_columns`)."""
+    judged. `t` has the physical columns (`physical.physical_columns`)."""
     req, lc = study.requirements, study.load_cases
     solved = t["status"] == "ok"
     out = pd.DataFrame(index=t.index)
