@@ -20,9 +20,9 @@ from __future__ import annotations
 import argparse
 import time
 
-from seadesign.loop import LoopData, explain
-from seadesign.loop.changepoint import best_split
-from seadesign.loop.sea import bench_loop_data, robot_declared, robot_loop_data
+from seadesign.calibration import LoopData, explain
+from seadesign.calibration.changepoint import best_split
+from seadesign.calibration.sea import bench_loop_data, robot_declared, robot_loop_data
 from seadesign.twin import BenchProtocol, KneeConfig, Trial, bench_effects, knee_effects, simulate, simulate_bench
 from simulate import SPRING  # the benchmarks' spring.json payload (thesis spring, Wolfgang-OP knee)
 from record import machine

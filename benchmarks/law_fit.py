@@ -68,8 +68,8 @@ def main() -> None:
             if kept.exists():
                 cold.path("path", kept.stem).parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy(kept, cold.path("path", kept.stem))
-    from seadesign.loop.explain_file import explain_file
-    from seadesign.loop.law_family import FAMILIES, law_families, path_curve, spring_source, trial_law
+    from seadesign.calibration.explain_file import explain_file
+    from seadesign.calibration.law_family import FAMILIES, law_families, path_curve, spring_source, trial_law
 
     cache = ("the uncalibrated sweep's geometry, meshes, linear solves and paths (--sweep)" if args.sweep
              else "empty (--cold)" if args.cold else "as it is")

@@ -90,8 +90,8 @@ def loop_goal(args) -> tuple[Table, str]:
     from helpers_goal import GOAL, goal_recording
     from conftest import thesis_spring
 
-    from seadesign.loop import explain
-    from seadesign.loop.sea import robot_declared, robot_loop_data
+    from seadesign.calibration import explain
+    from seadesign.calibration.sea import robot_declared, robot_loop_data
 
     spring = thesis_spring()
     table = Table(["effect (range)", "plain model: named", "declared chain: named; unsupported",
@@ -122,15 +122,15 @@ def loop_goal(args) -> tuple[Table, str]:
         print(table.rows[-1], flush=True)
     return table, (f"{args.draws} draws per case of tests/helpers_goal.py (robot format, hanging knee stepping in "
                    "place, 100 Hz); the thesis's measured spring; declared chain: backlash and gear friction; held "
-                   "by tests/test_loop_goal.py")
+                   "by tests/test_calibration_goal.py")
 
 
 def loop_real(args) -> tuple[Table, str]:
     from conftest import SHARED, thesis_spring
 
     from seadesign.data import KNEE_NAMES, clean, is_hanging, read_recording
-    from seadesign.loop import explain
-    from seadesign.loop.sea import robot_declared, robot_loop_data
+    from seadesign.calibration import explain
+    from seadesign.calibration.sea import robot_declared, robot_loop_data
 
     spring = thesis_spring()
     table = Table(["file, knee", "named (in order)", "declared, unsupported", "held-out RMSE before -> after (rad)"])
@@ -147,7 +147,7 @@ def loop_real(args) -> tuple[Table, str]:
             print(table.rows[-1], flush=True)
     return table, ("`seadesign explain FILE --spring studies/thesis_measured_spring.json --knee l|r` on the recordings "
                    "in ../shared/data/deepsea/ (the data module's cleaning; declared chain: backlash and gear friction); "
-                   "held by tests/test_loop_real.py (to 1 %)")
+                   "held by tests/test_calibration_real.py (to 1 %)")
 
 
 TABLES = {"circular_shear": circular_shear, "ccx_path": ccx_path, "loop_goal": loop_goal, "loop_real": loop_real}

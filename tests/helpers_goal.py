@@ -1,5 +1,5 @@
 """The loop's goal cases: robot-format recordings with one effect drawn from a seeded range (see
-`test_loop_goal.py` for the protocol), written by `helpers_generators.robot`, apart from the simulator."""
+`test_calibration_goal.py` for the protocol), written by `helpers_generators.robot`, apart from the simulator."""
 
 from __future__ import annotations
 

@@ -74,7 +74,7 @@ def test_the_default_study_answer_and_its_handoff(tmp_path):
 
 
 def _documented_calibration_lines() -> list[str]:
-    """The printed lines of the worked calibration in docs/explanation/loop.md (its block starting "calibration:")."""
+    """The printed lines of the worked calibration in docs/explanation/calibration.md (its block starting "calibration:")."""
     page = (Path(__file__).resolve().parents[1] / "docs" / "explanation" / "loop.md").read_text()
     block = page.split("```\ncalibration:", 1)[1].split("```", 1)[0]
     return [line.strip() for line in ("calibration:" + block).splitlines() if line.strip()]
@@ -95,4 +95,4 @@ def test_the_documented_calibration_example_prints_what_the_docs_show(tmp_path):
     assert result.exit_code == 0, result.output
     printed = [line.strip() for line in result.output.splitlines()]
     for line in _documented_calibration_lines():
-        assert line in printed, f"{line!r} is not printed; update docs/explanation/loop.md to:\n{result.output}"
+        assert line in printed, f"{line!r} is not printed; update docs/explanation/calibration.md to:\n{result.output}"

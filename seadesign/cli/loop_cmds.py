@@ -9,10 +9,10 @@ import click
 from seadesign.cli import main
 from seadesign.errors import ConfigError
 from seadesign.design.spring import load_spring
-from seadesign.loop import CANDIDATES, ROLES
-from seadesign.loop.explain_file import explain_file
+from seadesign.calibration import CANDIDATES, ROLES
+from seadesign.calibration.explain_file import explain_file
 from seadesign.constants import THESIS_K_MEASURED_NM_PER_RAD
-from seadesign.loop.thesis import K_FEA_NM_PER_RAD, worked_example
+from seadesign.calibration.thesis import K_FEA_NM_PER_RAD, worked_example
 
 #: older role names the generic table's --signal still accepts (the loop's vocabulary is the effect library's)
 _ROLE_ALIASES = {"displacement": "deflection"}

@@ -23,8 +23,8 @@ from typing import Any
 
 from seadesign.data import clean, is_hanging, read_recording
 from seadesign.design.spring import CurveRangeError
-from seadesign.loop.engine import SCALE, explain
-from seadesign.loop.sea import robot_declared, robot_loop_data
+from seadesign.calibration.engine import SCALE, explain
+from seadesign.calibration.sea import robot_declared, robot_loop_data
 
 #: the k scales the corrector is tested robust to (goal.robustness_cases)
 ROBUST_SCALE = (0.7, 1.4)

@@ -61,7 +61,7 @@ class SensorStep(Effect):
 
     Several jumps are several instances. Unlike an offset (present from the start) or a drift (a
     ramp), it changes the reading at one unknown instant, which a fitter finds by change-point
-    detection (`seadesign.loop.changepoint`) and then holds fixed while it fits the size.
+    detection (`seadesign.calibration.changepoint`) and then holds fixed while it fits the size.
     """
 
     key = "sensor_step"

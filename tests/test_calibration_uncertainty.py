@@ -13,8 +13,8 @@ import pytest
 
 from helpers_generators import K, bench, robot
 from seadesign.effects import LIBRARY, StiffnessScale
-from seadesign.loop import EffectModel, Term, time_blocks
-from seadesign.loop.sea import bench_loop_data, robot_loop_data
+from seadesign.calibration import EffectModel, Term, time_blocks
+from seadesign.calibration.sea import bench_loop_data, robot_loop_data
 
 DRAWS = 40
 # case -> (generator, effects, the effect fitted besides the scale (None: the scale alone), checked parameter);
@@ -79,8 +79,8 @@ def test_a_declared_spring_beside_a_true_effect_comes_back_within_its_uncertaint
 def test_the_report_names_the_trade_off_of_a_declared_effect(spring_dict):
     """A robot recording with a 0.03 rad backlash beside the declared 0.0044 rad: the declared backlash is refitted,
     and its check says it trades off with the stiffness scale."""
-    from seadesign.loop import explain
-    from seadesign.loop.sea import robot_declared
+    from seadesign.calibration import explain
+    from seadesign.calibration.sea import robot_declared
 
     ex = explain(robot_loop_data(robot({"dead_band": {"width_rad": 0.03}}, seed=7), spring_dict),
                  robot_declared(spring_dict))

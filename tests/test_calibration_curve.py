@@ -7,8 +7,8 @@ import pytest
 
 from helpers_generators import K, robot
 from seadesign.effects import CurveRangeError
-from seadesign.loop import explain
-from seadesign.loop.sea import robot_loop_data
+from seadesign.calibration import explain
+from seadesign.calibration.sea import robot_loop_data
 
 K3 = -80.0  # the generator's spring softens: T = k d + K3 d^3 (monotone up to 0.19 rad)
 

@@ -15,7 +15,7 @@ criteria use every training sample. Uncertainties: the sandwich cov = (J^T J)^-1
 the fitted rows (rescaled to the full count), S the Newey-West sum of the products J_t r_t over lags up to
 the smoother's window (~0.1 s), over which the smoothed input's noise correlates neighbouring residuals
 (without it the scatter over noise draws was up to 2.1 times the uncertainty reported on a robot recording,
-`tests/test_loop_uncertainty.py`). Residuals of real recordings are correlated for longer (structure the model
+`tests/test_calibration_uncertainty.py`). Residuals of real recordings are correlated for longer (structure the model
 lacks), so there these are lower bounds. AIC = n ln(SSR/n) + 2p, BIC = n ln(SSR/n) + p ln n (held
 parameters count). A fit that ends without least_squares' convergence says so (`converged`).
 """
@@ -29,9 +29,9 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from seadesign.effects import Param
-from seadesign.loop.metrics import split_metrics
-from seadesign.loop.table import LoopData
-from seadesign.loop.terms import Term, predict, whole_record
+from seadesign.calibration.metrics import split_metrics
+from seadesign.calibration.table import LoopData
+from seadesign.calibration.terms import Term, predict, whole_record
 
 MAX_FIT_ROWS = 8000
 HAC_LAGS = 2

@@ -33,7 +33,7 @@ def synthetic_family():
     """A `LawFamily` of the closed form at the nodes, 31 points to 0.3 rad each (no paths computed)."""
     from seadesign.design.materials import load_material
     from seadesign.design.spring import TorqueCurve
-    from seadesign.loop.law_family import LawFamily
+    from seadesign.calibration.law_family import LawFamily
 
     theta = np.linspace(0.0, 0.3, 31)
     curves = tuple(TorqueCurve(tuple(theta), tuple(shaped_torque(theta, v))) for v in NODES)
@@ -43,7 +43,7 @@ def synthetic_family():
 
 def test_trial_laws_keep_the_initial_shear_modulus_and_compressibility():
     from seadesign.design.materials import load_material
-    from seadesign.loop.law_family import SpringSourceError, base_value, trial_law
+    from seadesign.calibration.law_family import SpringSourceError, base_value, trial_law
 
     base = load_material("ninjaflex").law
     mr, yeoh = trial_law(base, "mooney_rivlin", 0.3), trial_law(base, "yeoh", -0.05)
@@ -73,9 +73,9 @@ def test_the_loop_names_the_law_shape_and_recovers_it_with_the_scale(spring_dict
     from helpers_generators import bench_curve
 
     from seadesign.design.materials import load_material
-    from seadesign.loop import explain
-    from seadesign.loop.law_family import MooneyRivlinShape
-    from seadesign.loop.sea import bench_loop_data, fitted_law
+    from seadesign.calibration import explain
+    from seadesign.calibration.law_family import MooneyRivlinShape
+    from seadesign.calibration.sea import bench_loop_data, fitted_law
 
     family = synthetic_family()
     curve = {"rotation_rad": list(family.curves[0].rotation_rad), "torque_Nm": list(family.curves[0].torque_Nm),
@@ -104,9 +104,9 @@ def test_the_loop_names_the_law_shape_and_recovers_it_with_the_scale(spring_dict
 def test_the_loop_names_no_shape_on_the_materials_own_curve(spring_dict):
     from helpers_generators import bench_curve
 
-    from seadesign.loop import explain
-    from seadesign.loop.law_family import MooneyRivlinShape
-    from seadesign.loop.sea import bench_loop_data
+    from seadesign.calibration import explain
+    from seadesign.calibration.law_family import MooneyRivlinShape
+    from seadesign.calibration.sea import bench_loop_data
 
     family = synthetic_family()
     curve = {"rotation_rad": list(family.curves[0].rotation_rad), "torque_Nm": list(family.curves[0].torque_Nm),
@@ -124,8 +124,8 @@ def test_a_spring_whose_study_is_missing_is_refused_for_the_law_and_fitted_for_t
     from helpers_generators import bench_curve
 
     from seadesign.design.spring import write_spring
-    from seadesign.loop.explain_file import explain_file
-    from seadesign.loop.law_family import SpringSourceError
+    from seadesign.calibration.explain_file import explain_file
+    from seadesign.calibration.law_family import SpringSourceError
 
     theta = np.linspace(0.0, 0.3, 16)
     curve = {"rotation_rad": theta.tolist(), "torque_Nm": shaped_torque(theta).tolist(),
@@ -203,7 +203,7 @@ def _bench_file(path: Path, rotation_rad, torque_Nm, reach_rad: float, seed: int
 def test_a_mooney_rivlin_bench_curve_from_calculix_is_fitted_as_its_law(bench_spring, ccx, monkeypatch):
     """A part at half the material's modulus with 60 % of it in C01: the loop names the Mooney-Rivlin shape,
     2 (C10 + C01) comes back within 2 % and C10 and C01 each within 3 reported uncertainties."""
-    from seadesign.loop.explain_file import explain_file
+    from seadesign.calibration.explain_file import explain_file
 
     folder, spring_path = bench_spring
     monkeypatch.chdir(folder)
@@ -236,8 +236,8 @@ def test_a_yeoh_bench_curve_is_told_apart_or_said_to_be_indistinguishable(bench_
     file's strains the shapes cannot be told apart; the modulus comes back within 2 % either way. Measured: no
     shape is named (held-out RMSE with Yeoh within 1 % of the material's own law)."""
     from seadesign.design.materials import load_material
-    from seadesign.loop.explain_file import explain_file
-    from seadesign.loop.law_family import path_curve, spring_source
+    from seadesign.calibration.explain_file import explain_file
+    from seadesign.calibration.law_family import path_curve, spring_source
 
     folder, spring_path = bench_spring
     monkeypatch.chdir(folder)
@@ -265,7 +265,7 @@ def test_a_yeoh_bench_curve_is_told_apart_or_said_to_be_indistinguishable(bench_
 def test_a_spring_json_whose_curve_its_study_no_longer_gives_is_refused(bench_spring, monkeypatch, tmp_path):
     """The study's candidate under the material's law must give spring.json's curve point by point (any change of
     study, material, solver or code since the sweep shows there)."""
-    from seadesign.loop.law_family import SpringSourceError, spring_source
+    from seadesign.calibration.law_family import SpringSourceError, spring_source
 
     folder, spring_path = bench_spring
     monkeypatch.chdir(folder)

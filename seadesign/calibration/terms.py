@@ -38,7 +38,7 @@ from scipy.ndimage import shift
 from seadesign.effects import LIBRARY, Effect
 from seadesign.effects.base import lowpass
 from seadesign.effects.spring import dahl, dahl_in_series, sls_deflection, softening_marched, solve_cubic
-from seadesign.loop.table import LoopData
+from seadesign.calibration.table import LoopData
 
 PLACES: dict[str, str] = {
     "sensor_delay": "sensor", "sensor_offset": "sensor", "sensor_step": "sensor", "sensor_drift": "sensor",

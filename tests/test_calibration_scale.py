@@ -13,8 +13,8 @@ import pytest
 
 from helpers_generators import bench, bench_curve
 from seadesign.effects import CurveRangeError
-from seadesign.loop import explain
-from seadesign.loop.sea import bench_loop_data
+from seadesign.calibration import explain
+from seadesign.calibration.sea import bench_loop_data
 
 SCALES = [0.2, 0.5, 2.0, 3.0]
 

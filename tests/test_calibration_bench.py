@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from helpers_generators import K, bench
-from seadesign.loop import explain
-from seadesign.loop.sea import bench_loop_data
+from seadesign.calibration import explain
+from seadesign.calibration.sea import bench_loop_data
 
 DRAWS = [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)]
 

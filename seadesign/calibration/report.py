@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from seadesign.loop.engine import Explanation, TraceEntry  # noqa: E402
+from seadesign.calibration.engine import Explanation, TraceEntry  # noqa: E402
 
 
 def _trace_row(t: TraceEntry) -> dict:

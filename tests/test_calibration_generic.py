@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from seadesign.effects import GravityLoad
-from seadesign.loop import EffectModel, LoopData, Term, explain
+from seadesign.calibration import EffectModel, LoopData, Term, explain
 from seadesign.effects import Friction, SensorOffset, StiffnessScale
 
 

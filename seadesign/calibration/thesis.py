@@ -15,9 +15,9 @@ from typing import Any
 from seadesign.constants import (THESIS_BEARING_RADIUS_M, THESIS_FEA_RESULTS, THESIS_K_MEASURED_NM_PER_RAD,
                                  XH540_STALL_TORQUE_NM)
 from seadesign.data import write_bench
-from seadesign.loop.engine import Explanation, explain
-from seadesign.loop.report import write_report
-from seadesign.loop.sea import bench_loop_data, calibration
+from seadesign.calibration.engine import Explanation, explain
+from seadesign.calibration.report import write_report
+from seadesign.calibration.sea import bench_loop_data, calibration
 from seadesign.design.materials import load_material
 from seadesign.twin import BenchProtocol, bench_effects, simulate_bench
 

@@ -6,7 +6,7 @@ modulus mu = 2 (C10 + C01), for Yeoh the ratio C20 / C10. A `LawFamily` holds th
 spring's own part (the study and candidate of spring.json, `spring_source`) at a few values of that parameter,
 each at the material's mu and compressibility, and interpolates between them: quadratic (Lagrange) in the
 parameter at each rotation, the curves being smooth in the law's parameters. Its error against full paths at the
-midpoints is measured by `benchmarks/law_fit.py` (docs/validation/loop.md); on a closed-form family the
+midpoints is measured by `benchmarks/law_fit.py` (docs/validation/calibration.md); on a closed-form family the
 interpolation is tested to be exact.
 
 The paths come from the stage cache (the material's own one is the sweep's). spring.json is refused when its study
@@ -28,7 +28,7 @@ from seadesign.design.spring import TorqueCurve, torque_curve
 from seadesign.design.study import Study, load_study
 from seadesign.effects.base import Effect, Param
 from seadesign.errors import ConfigError
-from seadesign.loop.table import LoopData, LoopInputError
+from seadesign.calibration.table import LoopData, LoopInputError
 from seadesign.run.executors import default_jobs, run_processes, run_serial
 from seadesign.sweep.handoff import curve_to_stop
 from seadesign.sweep.single import CandidatePath, candidate_path

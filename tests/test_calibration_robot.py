@@ -5,7 +5,7 @@ One knee of a hanging robot stepping in place, 100 Hz, 60 s (thermal softening: 
 draws; the first by default, the others with the slow tests), explains the Hall angle with the plain model
 (the spring's k, refitted) and checks that exactly that effect is named and its parameter (library name and
 unit) recovered within the stated relative tolerance. The goal cases with the declared chain are in
-`test_loop_goal.py`.
+`test_calibration_goal.py`.
 
 Detectability at these settings (seed 20, measured): a Dahl loop (sigma 50 Nm/rad) is named from tau_h = 0.02 Nm
 (held-out RMSE 16 % lower) and not at 0.01 Nm. A Maxwell arm (tr 0.2 s) below about 5 Nm/rad is an ambiguity
@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 from helpers_generators import robot
-from seadesign.loop import explain
-from seadesign.loop.sea import robot_declared, robot_loop_data
+from seadesign.calibration import explain
+from seadesign.calibration.sea import robot_declared, robot_loop_data
 
 DRAWS = [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)]
 

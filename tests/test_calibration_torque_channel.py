@@ -13,8 +13,8 @@ from __future__ import annotations
 import pytest
 
 from helpers_generators import K, bench_curve
-from seadesign.loop import explain
-from seadesign.loop.sea import bench_loop_data
+from seadesign.calibration import explain
+from seadesign.calibration.sea import bench_loop_data
 
 
 def linear(theta):

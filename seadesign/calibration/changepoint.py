@@ -4,7 +4,7 @@
 the sum of squared deviations from the segment means, found for all candidate indices at once
 from cumulative sums (the CUSUM statistic, O(n)). It is the `ruptures` library's `Binseg` with
 `model="l2"` for one break, about a thousand times faster on 60k samples (measured in
-`benchmarks/explain.py`; tested against ruptures in `tests/test_loop_changepoint.py`).
+`benchmarks/explain.py`; tested against ruptures in `tests/test_calibration_changepoint.py`).
 """
 
 from __future__ import annotations

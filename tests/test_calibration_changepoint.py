@@ -1,4 +1,4 @@
-"""Change-point detection (`seadesign.loop.changepoint`) against the ruptures library it stands in for, and the
+"""Change-point detection (`seadesign.calibration.changepoint`) against the ruptures library it stands in for, and the
 engine's search window for a sensor step (10-90 % of the record) on robot-format recordings."""
 
 from __future__ import annotations
@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from helpers_generators import robot
-from seadesign.loop import explain
-from seadesign.loop.changepoint import best_split, split_gains
-from seadesign.loop.sea import robot_loop_data
+from seadesign.calibration import explain
+from seadesign.calibration.changepoint import best_split, split_gains
+from seadesign.calibration.sea import robot_loop_data
 
 
 @pytest.mark.parametrize("seed", range(5))

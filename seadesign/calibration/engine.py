@@ -33,11 +33,11 @@ from typing import Sequence
 import numpy as np
 
 from seadesign.effects import Effect, SensorStep, StiffnessScale
-from seadesign.loop.changepoint import best_split
-from seadesign.loop.model import EffectModel, Fit, evaluate
-from seadesign.loop.table import LoopData, LoopInputError, time_blocks
-from seadesign.loop.terms import CANDIDATES, LAW_SHAPES, Term, applicable
-from seadesign.loop.whiteness import residual_tests
+from seadesign.calibration.changepoint import best_split
+from seadesign.calibration.model import EffectModel, Fit, evaluate
+from seadesign.calibration.table import LoopData, LoopInputError, time_blocks
+from seadesign.calibration.terms import CANDIDATES, LAW_SHAPES, Term, applicable
+from seadesign.calibration.whiteness import residual_tests
 
 SCALE = "stiffness_scale"
 

@@ -25,8 +25,8 @@ from __future__ import annotations
 import pytest
 
 from helpers_goal import GOAL, goal_recording
-from seadesign.loop import explain
-from seadesign.loop.sea import robot_declared, robot_loop_data
+from seadesign.calibration import explain
+from seadesign.calibration.sea import robot_declared, robot_loop_data
 
 DRAWS = [0, pytest.param(1, marks=pytest.mark.slow), pytest.param(2, marks=pytest.mark.slow)]
 @pytest.mark.parametrize("draw_index", DRAWS)

@@ -13,13 +13,13 @@ SEA adapters (`sea.py`) build `LoopData` and the declared effects from a bench f
 recording and a spring.json; `report.py` writes Markdown, HTML, JSON, plots and the calibration JSON.
 """
 
-from seadesign.loop.changepoint import best_split
-from seadesign.loop.engine import DeclaredCheck, Explanation, Step, TraceEntry, explain
-from seadesign.loop.metrics import metrics, split_metrics
-from seadesign.loop.model import EffectModel, Fit
-from seadesign.loop.table import ROLES, LoopData, LoopInputError, from_frame, time_blocks
-from seadesign.loop.terms import CANDIDATES, Term, predict
-from seadesign.loop.whiteness import residual_tests
+from seadesign.calibration.changepoint import best_split
+from seadesign.calibration.engine import DeclaredCheck, Explanation, Step, TraceEntry, explain
+from seadesign.calibration.metrics import metrics, split_metrics
+from seadesign.calibration.model import EffectModel, Fit
+from seadesign.calibration.table import ROLES, LoopData, LoopInputError, from_frame, time_blocks
+from seadesign.calibration.terms import CANDIDATES, Term, predict
+from seadesign.calibration.whiteness import residual_tests
 
 __all__ = [
     "CANDIDATES", "ROLES", "DeclaredCheck", "EffectModel", "Explanation", "Fit", "LoopData", "LoopInputError", "Step",

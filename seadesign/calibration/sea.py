@@ -30,10 +30,10 @@ from seadesign.design.materials import Hyperelastic, Material, load_material
 from seadesign.errors import ConfigError
 from seadesign.design.spring import torque_curve
 from seadesign.effects import DeadBand, Effect, Friction, spring_law
-from seadesign.loop.engine import SCALE, Explanation, TraceEntry
-from seadesign.loop.model import Fit
-from seadesign.loop.table import LoopData, LoopInputError, smooth_rate
-from seadesign.loop.terms import LAW_SHAPES
+from seadesign.calibration.engine import SCALE, Explanation, TraceEntry
+from seadesign.calibration.model import Fit
+from seadesign.calibration.table import LoopData, LoopInputError, smooth_rate
+from seadesign.calibration.terms import LAW_SHAPES
 from seadesign.twin.config import GEAR_COULOMB_NM
 
 #: the robot model's declared effects: library key -> name in the model

@@ -18,8 +18,8 @@ import pytest
 
 from conftest import shared_path
 from seadesign.data import KNEE_NAMES, clean, is_hanging, read_recording
-from seadesign.loop import explain
-from seadesign.loop.sea import robot_declared, robot_loop_data
+from seadesign.calibration import explain
+from seadesign.calibration.sea import robot_declared, robot_loop_data
 
 TABLE = Path(__file__).resolve().parents[1] / "docs" / "validation" / "_fragments" / "loop_real.md"
 

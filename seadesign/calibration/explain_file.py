@@ -13,11 +13,11 @@ import pandas as pd
 from seadesign.data import clean, is_hanging, read_bench, read_recording
 from seadesign.design.spring import load_spring
 from seadesign.errors import ConfigError
-from seadesign.loop.engine import Explanation, explain
-from seadesign.loop.law_family import FAMILIES, bench_shapes
-from seadesign.loop.report import write_report
-from seadesign.loop.sea import ROBOT_DECLARED, bench_loop_data, calibration, robot_declared, robot_loop_data
-from seadesign.loop.table import ROLES, LoopData, from_frame
+from seadesign.calibration.engine import Explanation, explain
+from seadesign.calibration.law_family import FAMILIES, bench_shapes
+from seadesign.calibration.report import write_report
+from seadesign.calibration.sea import ROBOT_DECLARED, bench_loop_data, calibration, robot_declared, robot_loop_data
+from seadesign.calibration.table import ROLES, LoopData, from_frame
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -159,7 +159,7 @@ def explain_file(file: str | Path, spring: str | Path | None = None, *, out_dir:
     measured, predicted : str, optional
         Generic table: the measured column and the model's prediction (same unit).
     signals : dict of str to str, optional
-        Generic table: role -> column (roles: ``seadesign.loop.ROLES``).
+        Generic table: role -> column (roles: ``seadesign.calibration.ROLES``).
     units : dict of str to str, optional
         Generic table: role -> unit, for the report.
     measured_unit : str

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 from seadesign.cli import main
 from seadesign.data import write_bench
 from seadesign.constants import THESIS_K_MEASURED_NM_PER_RAD as K_MEASURED_NM_PER_RAD
-from seadesign.loop.thesis import K_FEA_NM_PER_RAD
+from seadesign.calibration.thesis import K_FEA_NM_PER_RAD
 from seadesign.twin import BenchProtocol, bench_effects, simulate_bench
 
 
