@@ -1,14 +1,16 @@
-"""Family-2 training benchmark: the corrector trained through the closed loop in the torch knee, from scratch and
-fine-tuning family 1 (the default of `seadesign train`), with the bundles for the comparison.
+"""Closed-loop policy training benchmark: the corrector trained through the closed loop in the torch knee, from
+scratch and fine-tuning the reference network (the default of `seadesign train`), with the bundles for the comparison.
 
-Trains family 1 (`train_reference_bundle`: ILC labels, then the network), family 2 fine-tuning it (the default,
-`train_closedloop_bundle`) and family 2 from scratch, and writes the three bundles into --out. Prints per run the
-wall time to its stop rule (family 2, `closedloop_training`: the validation trials' mean |Hall error| not 1 % below
-its best for `patience` epochs; family 1: `benchmarks/train_reference.py`), the epochs, the simulated steps per
+Trains the reference network (`train_reference_bundle`: ILC labels, then the network), the closed-loop policy
+fine-tuning it (the default, `train_closedloop_bundle`) and the closed-loop policy from scratch, and writes the three
+bundles into --out. Prints per run the wall time to its stop rule (the closed-loop policy, `closedloop_training`: the
+validation trials' mean |Hall error| not 1 % below its best for `patience` epochs; the reference network:
+`benchmarks/train_reference.py`), the epochs, the simulated steps per
 second (one step = one 10 ms sample of the whole batch: training and validation trials x hanging/ground x k scales
 x 2 knees; the no-gradient passes and the BPTT windows together, and the BPTT windows alone), and the NumPy
 runtime's latency per control step (median), the default bundle's single-call latency on each path (ONNX Runtime,
-NumPy, TorchScript; 1 thread), then the default's wall time (family 1 + fine-tuning). Compare the bundles with
+NumPy, TorchScript; 1 thread), then the default's wall time (the reference network + fine-tuning). Compare the bundles
+with
 
     python benchmarks/closed_loop_goal.py OUT/reference-ilc OUT/closedloop-scratch OUT/closedloop --spring SPRING
 
@@ -98,48 +100,52 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--spring", type=Path, default=THESIS_SPRING)
     ap.add_argument("--out", type=Path, default=Path("exports") / "benchmark_closedloop", help="bundles go here")
-    ap.add_argument("--threads", type=int, default=1, help="torch intra-op threads for family-2 training")
+    ap.add_argument("--threads", type=int, default=1, help="torch intra-op threads for closed-loop training")
     ap.add_argument("--calls", type=int, default=3000, help="runtime latency: command calls timed")
     add_docs_option(ap, "closedloop_training")
     args = ap.parse_args()
     spring = load_spring(args.spring)
     k = spring["k_Nm_per_rad"]
     base = ClosedLoopSettings(threads=args.threads, max_seconds=CAPS_S["closedloop"])  # as `seadesign train`
-    knees = (len(base.directions) * (len(base.speeds) + len(base.val_speeds)) * len(base.settings)
+    knees = (len(base.directions) * (len(base.speeds) + len(base.val_speeds)) * len(base.conditions)
              * len(base.k_scales) * 2)
     print(f"machine: {machine()}; torch {torch.__version__}, seadesign {__version__}; spring {args.spring} "
           f"(k {k:.4g} Nm/rad)")
-    settings = (f"Family 2: {len(base.directions)} directions x speeds {base.speeds} (training) and {base.val_speeds} "
-                f"(validation), {base.trial_s:g} s trials, {' and '.join(base.settings)}, k x {base.k_scales}, noise on, "
+    settings = (f"The closed-loop policy: {len(base.directions)} directions x speeds {base.speeds} (training) and "
+                f"{base.val_speeds} "
+                f"(validation), {base.trial_s:g} s trials, {' and '.join(base.conditions)}, k x {base.k_scales}, noise on, "
                 f"float64 knee; windows of {base.window_steps} samples, feedback Lipschitz bound "
                 f"{base.lipschitz_rad_per_rad} rad/rad, command-rate weight {base.rate_weight_s2:g} s^2; stop: < "
                 f"{base.min_improvement:.0%} for {base.patience} epochs (cap {base.max_seconds:g} s); threads "
                 f"{args.threads}; batch {knees} knees (steps/s: samples of the batch)")
     print(settings, flush=True)
     table = Table(COLUMNS)
-    _, family1, _ = train_reference_bundle(args.spring, args.out / "reference-ilc",
+    _, imitation, _ = train_reference_bundle(args.spring, args.out / "reference-ilc",
                                            capped_reference_settings(CAPS_S["reference"]))
-    family1_s = family1.label_s + family1.training.summary()["wall_s"]
-    print(f"family 1: ILC labels {family1.label_s:.1f} s + network {family1.training.summary()['wall_s']:.1f} s = "
-          f"{family1_s:.0f} s -> {args.out / 'reference-ilc'}", flush=True)
-    table.add("family 1: ILC labels + network", "", "", "", "", f"{family1_s:.0f}", "", "", "", "", "")
+    imitation_s = imitation.label_s + imitation.training.summary()["wall_s"]
+    print(f"the reference network: ILC labels {imitation.label_s:.1f} s + network "
+          f"{imitation.training.summary()['wall_s']:.1f} s = "
+          f"{imitation_s:.0f} s -> {args.out / 'reference-ilc'}", flush=True)
+    table.add("the reference network: ILC labels + network", "", "", "", "", f"{imitation_s:.0f}", "", "", "", "", "")
     print(" | ".join(COLUMNS))
     fine_tuning = replace(FINE_TUNING, threads=args.threads, max_seconds=CAPS_S["closedloop"])
     _, tuned, _ = train_closedloop_bundle(args.spring, args.out / "closedloop", fine_tuning,
-                                          family1=family1)
-    table.add(*_row("family 2 fine-tuning family 1 (default)", tuned, k, args.calls))
+                                          imitation=imitation)
+    table.add(*_row("the closed-loop policy fine-tuning the reference network (default)", tuned, k, args.calls))
     _print(table.rows[-1])
     scratch = train_closed_loop(spring, base)
     export_closedloop_bundle(scratch, args.spring, args.out / "closedloop-scratch", {"init": "scratch"},
                              name="closedloop-scratch")
-    table.add(*_row("family 2 from scratch", scratch, k, args.calls))
+    table.add(*_row("the closed-loop policy from scratch", scratch, k, args.calls))
     _print(table.rows[-1])
     paths = _paths_us(args.out / "closedloop", args.calls)
     print("default bundle, one call of the flat forward (median): " + ", ".join(f"{p} {us:.1f} us" for p, us in
                                                                               paths.items())
           + f" (budget {STEP_BUDGET_US:.0f} us: {'within' if max(paths.values()) <= STEP_BUDGET_US else 'OVER'})")
-    print(f"default `seadesign train` (family 1, then fine-tuned): {family1_s + tuned.wall_s:.0f} s to a converged "
-          f"family-2 corrector; from scratch {scratch.wall_s:.0f} s. Bundles in {args.out}. Other processes share "
+    print(f"default `seadesign train` (the reference network, then fine-tuned): {imitation_s + tuned.wall_s:.0f} s "
+          f"to a "
+          f"converged "
+          f"closed-loop corrector; from scratch {scratch.wall_s:.0f} s. Bundles in {args.out}. Other processes share "
           "this CPU.")
     if args.docs:
         write_fragment("closedloop_training", table, settings + f"; spring {args.spring}",

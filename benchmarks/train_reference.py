@@ -1,4 +1,4 @@
-"""Family 1 benchmark: ILC labels in the knee simulator and the reference-window network trained on them.
+"""The reference network benchmark: ILC labels in the knee simulator and the reference-window network trained on them.
 
 Reports the label stage (ILC iterations per batch, simulated knee steps per second, wall time), the
 training (samples/s, epochs, stop reason, wall time to the early stop: no better validation MSE on
@@ -51,7 +51,7 @@ def main() -> None:
     print(f"machine: {machine()}; torch {torch.__version__}")
     print(f"spring: {args.spring} (k {spring['k_Nm_per_rad']:.4g} Nm/rad, curve: {'torque_curve' in spring}); "
           f"labels: {len(settings.trials())} trials x {settings.trial_s:g} s at {settings.rate_hz:g} Hz, settings "
-          f"{', '.join(settings.settings)}, k scales {settings.k_scales}; training threads {settings.train.threads}, "
+          f"{', '.join(settings.conditions)}, k scales {settings.k_scales}; training threads {settings.train.threads}, "
           f"batch {settings.train.batch_size}, patience {settings.train.patience} epochs")
     if args.out:
         _, res, _ = train_reference_bundle(args.spring, args.out, settings)

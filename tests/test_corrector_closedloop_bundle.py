@@ -1,6 +1,6 @@
-"""Family 2's bundle: ONNX, NumPy and TorchScript give the PyTorch policy's commands to 1e-6 rad, with the feedback
-branch doing real work; meta.json (also inside the ONNX file) carries inputs, units, normalisation, k, the feedback
-bound and the simulator; the loaded bundle drives the knee as the policy in memory and passes `evaluate`."""
+"""The closed-loop policy's bundle: ONNX, NumPy and TorchScript give the PyTorch policy's commands to 1e-6 rad, with
+the feedback branch doing real work; meta.json (also inside the ONNX file) carries inputs, units, normalisation, k,
+the feedback bound and the simulator; the loaded bundle drives the knee as the policy in memory and passes `evaluate`."""
 
 from __future__ import annotations
 
@@ -97,7 +97,7 @@ def test_meta_carries_inputs_units_normalisation_k_bound_and_simulator(bundle):
     assert bound == pytest.approx(result.policy.feedback_lipschitz_bound()) and 0.4 < bound <= 0.5 + 1e-6
     np.testing.assert_array_equal(np.float32(meta["normalisation"]["x_std"]), result.policy.ff.x_std.numpy())
     sim = meta["simulator"]
-    assert sim["k_scales"] == [0.8, 1.0, 1.25] and sim["settings"] == ["hanging", "ground"]
+    assert sim["k_scales"] == [0.8, 1.0, 1.25] and sim["conditions"] == ["hanging", "ground"]
     assert sim["config"]["p_gain_Nm_per_rad"] == 60.0 and "ground_contact" in str(sim["effects"]["ground"])
     assert meta["training"]["epochs_run"] == 2 and meta["onnx"] == {"file": "corrector.onnx"}
 

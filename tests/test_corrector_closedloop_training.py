@@ -1,4 +1,4 @@
-"""Family 2, trained through the closed loop: the feedback's Lipschitz bound holds, gradients reach both
+"""The closed-loop policy, trained through the closed loop: the feedback's Lipschitz bound holds, gradients reach both
 branches through the torch knee, training lowers the validation error and is seeded, the NumPy runtime is the
 policy; slow: a corrector trained from scratch meets the closed-loop goal in every cell of the protocol."""
 
@@ -253,17 +253,17 @@ SLOW = ClosedLoopSettings(max_epochs=8)
 
 
 @pytest.mark.slow
-def test_family2_from_scratch_meets_the_closed_loop_goal_in_every_cell():
+def test_the_closed_loop_policy_from_scratch_meets_the_closed_loop_goal_in_every_cell():
     """The corrector trained for `SLOW` (k x0.8 / 1 / 1.25) meets the goal in all 36 cells of the thesis protocol
     (18 trials x hanging / ground) against none, PI and the k-feed-forward in the NumPy simulator, with no unstable
     or oscillating flag. Measured: smallest gain 0.880 hanging, 0.756 ground (goal 0.30); mean |Hall error| 0.0129
     rad hanging, 0.0719 rad ground; rest chatter 0.0022 rad (flag 0.02); feedback bound 0.500 rad/rad. The
-    thresholds leave a few times the measured margin. (The default, fine-tuning family 1, is held in every case by
-    `test_corrector_reference.py`.)"""
+    thresholds leave a few times the measured margin. (The default, fine-tuning the reference network, is held in
+    every case by `test_corrector_reference.py`.)"""
     spring = thesis_spring()
     k = spring["k_Nm_per_rad"]
     res = train_closed_loop(spring, SLOW)
-    corrector = runtime_corrector(res.policy, k, name="family2")
+    corrector = runtime_corrector(res.policy, k, name="closedloop")
     runs, rows = {}, {}
     for setting in ("hanging", "ground"):
         table, runs[setting] = closed_loop_table([NoCorrection(), HallPI(), FeedForward(k), corrector], spring,

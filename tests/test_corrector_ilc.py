@@ -74,7 +74,7 @@ def test_ilc_keeps_the_correction_inside_its_bound_on_both_sides():
 
 
 def test_ilc_that_stops_before_its_plateau_is_not_a_label(spring_dict):
-    settings = ImitationSettings(speeds=(0.1,), settings=("hanging",), k_scales=(1.0,), trial_s=3.0,
+    settings = ImitationSettings(speeds=(0.1,), conditions=("hanging",), k_scales=(1.0,), trial_s=3.0,
                                  ilc=ILCSettings(max_iterations=2))
     with pytest.raises(SeadesignError, match="did not reach its plateau"):
         ilc_labels(spring_dict, settings)

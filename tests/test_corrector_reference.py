@@ -1,5 +1,6 @@
-"""Family 1, the reference-window feed-forward trained on ILC labels: the bundle; the simulator check; and the
-closed-loop comparison of family 1 with the default, family 2 fine-tuning it, in every case of the goal."""
+"""The reference network, the reference-window feed-forward trained on ILC labels: the bundle; the simulator check;
+and the closed-loop comparison of the reference network with the default, the closed-loop policy fine-tuning it, in
+every case of the goal."""
 
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ from seadesign.corrector.workflow import evaluate_bundles, load_corrector, train
 from seadesign.design.spring import write_spring
 from seadesign.twin import Trial, thesis_protocol
 
-SMALL = ImitationSettings(speeds=(0.075, 0.15), settings=("hanging",), k_scales=(1.0,), trial_s=6.0,
+SMALL = ImitationSettings(speeds=(0.075, 0.15), conditions=("hanging",), k_scales=(1.0,), trial_s=6.0,
                           ilc=ILCSettings(max_iterations=40))
 
 
@@ -35,7 +36,7 @@ def test_reference_bundle_records_its_simulator_and_runs_as_trained(tmp_path):
     meta = json.loads((bundle / "meta.json").read_text())
     assert meta["model"] == "reference" and meta["reference"] == {"past": 5, "preview": 10}
     assert meta["k_Nm_per_rad"] == spring["k_Nm_per_rad"] and meta["control_rate_hz"] == 100.0
-    assert meta["simulator"]["config"]["p_gain_Nm_per_rad"] == 60.0 and meta["simulator"]["settings"] == ["hanging"]
+    assert meta["simulator"]["config"]["p_gain_Nm_per_rad"] == 60.0 and meta["simulator"]["conditions"] == ["hanging"]
     assert meta["input_units"][meta["inputs"].index("k_Nm_per_rad")] == "Nm/rad"
     assert meta["input_units"][meta["inputs"].index("load_share")].startswith("1")
     X, _, _ = label_arrays(result.labels, SMALL.window)
@@ -62,8 +63,8 @@ def meta_check(bundle) -> list:
 
 
 #: thresholds of the comparison below, with room for a run cut by its time cap on a slow machine; measured (this
-#: test and benchmarks/closed_loop_goal.py): family 2 keeps >= 0.722 of its nominal gain, family 1 0.699; mean
-#: |Hall error| over cases and settings 0.0535 and 0.0656 rad
+#: test and benchmarks/closed_loop_goal.py): the closed-loop policy keeps >= 0.722 of its nominal gain, the
+#: reference network 0.699; mean |Hall error| over cases and settings 0.0535 and 0.0656 rad
 KEPT_SHARE_MIN = 0.6
 FAMILY2_MEAN_RAD = 0.06
 DEFAULT_MARGIN_MIN = 0.75
@@ -71,12 +72,13 @@ DEFAULT_MARGIN_MIN = 0.75
 
 @pytest.mark.slow
 def test_default_train_wins_the_comparison_meets_the_goal_and_is_robust(tmp_path):
-    """`seadesign train --model reference,closedloop` on the thesis spring trains family 1 and the default, family 2
-    fine-tuning it (the same network the default trains). Over every case of `goal_cases` (the protocol, whose
+    """`seadesign train --model reference,closedloop` on the thesis spring trains the reference network and the
+    default, the closed-loop policy fine-tuning it (the same network the default trains). Over every case of
+    `goal_cases` (the protocol, whose
     speeds no training used; a gait with a shorter cycle; k x0.7 and x1.4; real-knee effects; the softening curve),
     cell by cell (6 directions x 3 speeds x hanging and ground): both meet the goal on the protocol and the gait
-    and are robust in the other cases (no flag, >= half the nominal gain per cell), and family 2 wins (lower mean
-    |Hall error| over the cases), so the default is the winner of the closed-loop comparison."""
+    and are robust in the other cases (no flag, >= half the nominal gain per cell), and the closed-loop policy wins
+    (lower mean |Hall error| over the cases), so the default is the winner of the closed-loop comparison."""
     from seadesign.cli import main
 
     spring = thesis_spring()

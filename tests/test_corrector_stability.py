@@ -35,7 +35,7 @@ def learned():
     spec = DatasetSpec("command", ("motor_vel", "hall_vel", "effort"), 0, True)
     ds = build_dataset([rec], spec)
     mlp = fit(ds, make_split(ds, "time_blocks"), spring["k_Nm_per_rad"], TrainConfig(threads=1))
-    imitation = ImitationSettings(speeds=(0.075, 0.15), settings=("hanging",), k_scales=(1.0,), trial_s=6.0,
+    imitation = ImitationSettings(speeds=(0.075, 0.15), conditions=("hanging",), k_scales=(1.0,), trial_s=6.0,
                                   ilc=ILCSettings(max_iterations=40))
     ref = train_imitation(spring, imitation)
     return spring, NetCorrector(NumpyCorrector(numpy_arrays(mlp.net)), spec, "mlp"), \

@@ -4,8 +4,8 @@ Flow: recordings -> `build_dataset` (task, modalities, history, positive) -> `ma
 (time blocks / by recording / the thesis's random 80/20) -> `fit` -> `export_bundle`
 (TorchScript, ONNX, NumPy) -> open-loop (`open_loop_table`) and closed-loop (`closed_loop_table`, knee
 simulator) evaluation against the baselines; `iterate` retrains on runs with the corrector in the
-loop. The correctors that work in closed loop learn in the knee simulator instead: family 1 on ILC
-labels (`imitation`), family 2 (the default) fine-tuning it through the loop (`closedloop_training`).
+loop. The correctors that work in closed loop learn in the knee simulator instead: the reference network on ILC
+labels (`imitation`), the closed-loop policy (the default) fine-tuning it through the loop (`closedloop_training`).
 `train_bundle` / `train_reference_bundle` / `train_closedloop_bundle` / `evaluate_bundles` (`workflow`)
 are the CLI's workflows.
 """

@@ -1,10 +1,10 @@
-"""Family 2: a corrector trained through the closed loop, in the differentiable knee (`twin.torch_knee`).
+"""The closed-loop policy: a corrector trained through the closed loop, in the differentiable knee (`twin.torch_knee`).
 
 The policy, per knee and control step, in flexion (the right knee mirrored in and out):
 
     command = ff(x) + L [h(m, x) - h(0, x)]
 
-- x: the reference window (`reference.reference_features`, the family-1 inputs), so a family-1 network
+- x: the reference window (`reference.reference_features`, the reference-network inputs), so a reference-network network
   can be `ff` and be fine-tuned; from scratch `ff` starts as command = target;
 - m = (e, tau de/dt) (rad): the Hall error e = target - hall and its rate (target's finite difference
   minus the measured Hall velocity) times tau = `RATE_TIME_S` (one 100 Hz sample), so both are in rad;
@@ -153,7 +153,7 @@ class ClosedLoopPolicy(nn.Module):
     def from_scratch(cls, features: np.ndarray, window: ReferenceWindow, seed: int = 0,
                      **options: Any) -> "ClosedLoopPolicy":
         """A policy whose feed-forward starts at command = target (plus a small random correction), normalised on
-        `features` (N, d) (the training inputs); hidden 3 x 64 leaky ReLU as family 1."""
+        `features` (N, d) (the training inputs); hidden 3 x 64 leaky ReLU as the reference network."""
         torch.manual_seed(seed)
         x = torch.as_tensor(features, dtype=torch.float32)
         x_mean, x_std = x.mean(0), x.std(0)
@@ -169,7 +169,7 @@ class ClosedLoopPolicy(nn.Module):
     @classmethod
     def from_feedforward(cls, ff: CorrectorNet, window: ReferenceWindow, seed: int = 0,
                          **options: Any) -> "ClosedLoopPolicy":
-        """Fine-tune a family-1 network (a copy; the original is left as it is)."""
+        """Fine-tune a reference-network network (a copy; the original is left as it is)."""
         torch.manual_seed(seed)
         return cls(copy.deepcopy(ff).float(), window, **options)
 
@@ -201,7 +201,7 @@ class ClosedLoopSettings:
     speeds: tuple[float, ...] = TRAIN_SPEEDS
     val_speeds: tuple[float, ...] = VAL_SPEEDS
     directions: tuple[str, ...] = tuple(DIRECTIONS)
-    settings: tuple[str, ...] = ("hanging", "ground")
+    conditions: tuple[str, ...] = ("hanging", "ground")  # the leg hanging, the foot on the ground
     k_scales: tuple[float, ...] = TRAIN_K_SCALES
     trial_s: float = 10.0
     rate_hz: float = 100.0
@@ -224,8 +224,8 @@ class ClosedLoopSettings:
     threads: int = 1
 
     def __post_init__(self) -> None:
-        if not set(self.settings) <= {"hanging", "ground"} or not self.settings:
-            raise SeadesignError(f"settings must be hanging and/or ground, got {self.settings}")
+        if not set(self.conditions) <= {"hanging", "ground"} or not self.conditions:
+            raise SeadesignError(f"conditions must be hanging and/or ground, got {self.conditions}")
         if self.window_steps < 2 or self.windows_per_epoch < 0 or self.patience < 1 or self.max_epochs < 1:
             raise SeadesignError("window_steps must be >= 2, windows_per_epoch >= 0 (0: all), patience and "
                                  "max_epochs >= 1")
@@ -244,7 +244,7 @@ class ClosedLoopSettings:
         return asdict(self)
 
 
-#: settings for fine-tuning a family-1 network (the default corrector): Adam's step a tenth of the from-scratch
+#: settings for fine-tuning a reference-network network (the default corrector): Adam's step a tenth of the from-scratch
 #: one, as the feed-forward starts trained
 FINE_TUNING = ClosedLoopSettings(lr=1e-3)
 
@@ -291,7 +291,7 @@ def _batch(spring: dict, s: ClosedLoopSettings) -> _Batch:
     scaled per row; the policy's k input stays spring.json's (the corrector is not told the robot's k)."""
     train, val = s.trials(s.speeds), s.trials(s.val_speeds)
     _, target, stance = protocol_tensors(train + val, s.rate_hz, s.gait)
-    n, groups = len(train) + len(val), [(st, scale) for st in s.settings for scale in s.k_scales]
+    n, groups = len(train) + len(val), [(st, scale) for st in s.conditions for scale in s.k_scales]
     target = target.repeat(len(groups), 1, 1)
     ground = torch.tensor([float(st == "ground") for st, _ in groups]).repeat_interleave(n)
     scale = torch.tensor([scale for _, scale in groups], dtype=torch.float64).repeat_interleave(n)
@@ -355,7 +355,7 @@ def _record(policy: ClosedLoopPolicy, b: _Batch, window_steps: int) -> tuple[lis
 
 def train_closed_loop(spring: dict, settings: ClosedLoopSettings = ClosedLoopSettings(),
                       init: CorrectorNet | None = None) -> ClosedLoopResult:
-    """Train a family-2 policy through the torch knee; `init` a family-1 network to fine-tune (None: scratch)."""
+    """Train a closed-loop policy through the torch knee; `init` a reference network to fine-tune (None: scratch)."""
     threads_before = torch.get_num_threads()
     torch.set_num_threads(settings.threads or min(2, os.cpu_count() or 1))
     try:

@@ -1,4 +1,4 @@
-"""Family 1: a feed-forward network trained on iterative-learning-control labels.
+"""The reference network: a feed-forward network trained on iterative-learning-control labels.
 
 Labels: `ilc.learn_commands` in the knee simulator, for every walk direction at speeds that are
 not the thesis protocol's (so the protocol stays unseen), hanging and on the ground, and for the
@@ -38,7 +38,7 @@ class ImitationSettings:
 
     window: ReferenceWindow = ReferenceWindow()
     speeds: tuple[float, ...] = TRAIN_SPEEDS
-    settings: tuple[str, ...] = ("hanging", "ground")
+    conditions: tuple[str, ...] = ("hanging", "ground")  # the leg hanging, the foot on the ground
     k_scales: tuple[float, ...] = TRAIN_K_SCALES
     trial_s: float = 10.0
     rate_hz: float = 100.0
@@ -79,7 +79,7 @@ def ilc_labels(spring: dict, settings: ImitationSettings) -> list[ILCResult]:
     """ILC on the training trials for every setting and k scale; refuses a batch that did not converge."""
     base = KneeConfig.from_spring(spring)
     out = []
-    for setting in settings.settings:
+    for setting in settings.conditions:
         ground = setting == "ground"
         for scale in settings.k_scales:
             config = replace(base, k_Nm_per_rad=base.k_Nm_per_rad * scale)

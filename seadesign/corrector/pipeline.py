@@ -188,23 +188,24 @@ def train(spring: str | Path, models: str | tuple[str, ...] = "closedloop", data
     checks = check_simulator(doc, data) if preview else []
     for line in simulator_check_lines(checks):
         echo(line)
-    trained, family1 = [], None
-    for model in sorted(models, key=lambda m: m != "reference"):  # family 1 first: family 2 fine-tunes it
+    trained, imitation = [], None
+    for model in sorted(models, key=lambda m: m != "reference"):  # reference first: closedloop fine-tunes it
         if model in PREVIEW_MODELS:
             reference = capped_reference_settings(caps["reference"])
             folder = {"reference": "reference-ilc", "closedloop": "closedloop"}[model]
             target = root if (out and len(models) == 1) else root / folder
             if model == "reference":
-                path, family1, _ = train_reference_bundle(spring, target, reference, data_paths=data,
+                path, imitation, _ = train_reference_bundle(spring, target, reference, data_paths=data,
                                                           checks=checks)
-                s = family1.summary()["training"]
-                summary = (f"ILC labels {family1.label_s:.0f} s ({len(family1.labels)} batches); best validation MSE "
+                s = imitation.summary()["training"]
+                summary = (f"ILC labels {imitation.label_s:.0f} s ({len(imitation.labels)} batches); best validation "
+                           f"MSE "
                            f"{s['best_val_mse_rad2']:.4g} rad^2 at epoch {s['best_epoch']} ({s['stopped']}, "
                            f"{s['wall_s']:.1f} s)")
             else:
                 fine_tuning = replace(FINE_TUNING, max_seconds=caps["closedloop"])
-                path, res, _ = train_closedloop_bundle(spring, target, fine_tuning, family1=family1, data_paths=data,
-                                                       checks=checks, family1_settings=reference)
+                path, res, _ = train_closedloop_bundle(spring, target, fine_tuning, imitation=imitation,
+                                                       data_paths=data, checks=checks, imitation_settings=reference)
                 s = res.summary()
                 summary = (f"fine-tuned through the closed loop: validation mean |Hall error| "
                            f"{s['best_val_mean_abs_error_rad']:.4f} rad at epoch {s['best_epoch']} ({s['stopped']}, "

@@ -43,7 +43,7 @@ def protocol_loads(spring: dict[str, Any], settings: ImitationSettings = Imitati
     linear = {key: value for key, value in spring.items() if key != "torque_curve"}
     softest = min(min(settings.k_scales), min(FINE_TUNING.k_scales))
     out = []
-    for setting in sorted(set(settings.settings) | set(FINE_TUNING.settings)):
+    for setting in sorted(set(settings.conditions) | set(FINE_TUNING.conditions)):
         session = KneeSession(linear, settings.trials(), ground=setting == "ground", rate_hz=settings.rate_hz,
                               gait=settings.gait)
         peak = float(np.abs(session.spring_torque).max())

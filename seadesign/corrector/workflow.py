@@ -95,19 +95,20 @@ def _spring_record(spring_path: str | Path, spring: dict[str, Any]) -> dict[str,
             "inputs_hash": spring["inputs_hash"]}
 
 
-def _simulator_record(spring: dict[str, Any], settings: tuple[str, ...], k_scales: tuple[float, ...]) -> dict[str, Any]:
-    """The knee simulator a preview corrector was trained in: config, settings, effect chains, k scales (1)."""
+def _simulator_record(spring: dict[str, Any], conditions: tuple[str, ...], k_scales: tuple[float, ...]) -> dict[str, Any]:
+    """The knee simulator a preview corrector was trained in: config, conditions (hanging, ground), effect chains,
+    k scales (1)."""
     config = KneeConfig.from_spring(spring)
-    return {"config": config.as_dict(), "settings": list(settings), "k_scales": list(k_scales),
-            "effects": {s_: knee_effects(config, s_ == "ground").describe() for s_ in settings}}
+    return {"config": config.as_dict(), "conditions": list(conditions), "k_scales": list(k_scales),
+            "effects": {c: knee_effects(config, c == "ground").describe() for c in conditions}}
 
 
 def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
                            settings: ImitationSettings = ImitationSettings(), data_paths: list[str | Path] = (),
                            checks: list[SimulatorCheck] | None = None,
                            ) -> tuple[Path, ImitationResult, list[SimulatorCheck]]:
-    """Family 1: ILC labels in the simulator built from spring.json, the reference-window network trained on
-    them, exported as a bundle whose meta records the window, k, the simulator and the control rate. The
+    """The reference network: ILC labels in the simulator built from spring.json, the reference-window network
+    trained on them, exported as a bundle whose meta records the window, k, the simulator and the control rate. The
     recordings in `data_paths`, if any, check that simulator (`simcheck.check_simulator`, unless its `checks`
     are given; in meta)."""
     spring = load_spring(spring_path)
@@ -119,7 +120,7 @@ def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
         "output": "motor position command at t, rad, knee flexion (mirror the right knee in and out)",
         "k_Nm_per_rad": float(spring["k_Nm_per_rad"]), "spring": _spring_record(spring_path, spring),
         "control_rate_hz": settings.rate_hz,
-        "simulator": _simulator_record(spring, settings.settings, settings.k_scales),
+        "simulator": _simulator_record(spring, settings.conditions, settings.k_scales),
         "data": data_record(list(data_paths)), "simulator_check": [c.to_dict() for c in checks],
         "n_samples": int(sum(r.target_rad.size for r in result.labels)),
         "split": {"split": "held_out_trials", "val_every": settings.val_every},
@@ -131,26 +132,27 @@ def train_reference_bundle(spring_path: str | Path, out_dir: str | Path,
 
 
 def train_closedloop_bundle(spring_path: str | Path, out_dir: str | Path, settings: ClosedLoopSettings = FINE_TUNING,
-                            family1: ImitationResult | None = None, data_paths: list[str | Path] = (),
+                            imitation: ImitationResult | None = None, data_paths: list[str | Path] = (),
                             checks: list[SimulatorCheck] | None = None,
-                            family1_settings: ImitationSettings = ImitationSettings(),
+                            imitation_settings: ImitationSettings = ImitationSettings(),
                             ) -> tuple[Path, ClosedLoopResult, list[SimulatorCheck]]:
-    """Family 2, the default corrector: the family-1 network `family1` (trained here with `family1_settings`
-    when None) fine-tuned through the closed loop in the torch knee built from spring.json, exported by
-    `export_closedloop_bundle`; meta records family 1's training under "init". The recordings in `data_paths`,
-    if any, check that simulator (`simcheck.check_simulator`, unless its `checks` are given; in meta)."""
+    """The closed-loop policy, the default corrector: the reference network `imitation` (trained here with
+    `imitation_settings` when None) fine-tuned through the closed loop in the torch knee built from spring.json,
+    exported by `export_closedloop_bundle`; meta records the reference network's training under "init". The
+    recordings in `data_paths`, if any, check that simulator (`simcheck.check_simulator`, unless its `checks` are
+    given; in meta)."""
     spring = load_spring(spring_path)
     checks = check_simulator(spring, list(data_paths)) if checks is None else checks
-    family1 = train_imitation(spring, family1_settings) if family1 is None else family1
-    result = train_closed_loop(spring, settings, family1.training.net)
+    imitation = train_imitation(spring, imitation_settings) if imitation is None else imitation
+    result = train_closed_loop(spring, settings, imitation.training.net)
     meta = {"data": data_record(list(data_paths)), "simulator_check": [c.to_dict() for c in checks],
-            "init": {"family1": family1.summary()}}
+            "init": {"imitation": imitation.summary()}}
     return export_closedloop_bundle(result, spring_path, out_dir, meta), result, checks
 
 
 def export_closedloop_bundle(result: ClosedLoopResult, spring_path: str | Path, out_dir: str | Path,
                              record: dict[str, Any] | None = None, name: str = "closedloop") -> Path:
-    """A family-2 bundle named `name`: flat input the reference window then `MEASURED_INPUTS`; meta records the
+    """A closed-loop bundle named `name`: flat input the reference window then `MEASURED_INPUTS`; meta records the
     window, k, the feedback's certified bound, the simulator, control rate and training, plus `record`'s fields."""
     spring = load_spring(spring_path)
     policy, settings = result.policy, result.settings
@@ -165,7 +167,7 @@ def export_closedloop_bundle(result: ClosedLoopResult, spring_path: str | Path, 
         "feedback_lipschitz_bound_rad_per_rad": policy.feedback_lipschitz_bound(),
         "normalisation": {**normalisation(policy.ff), "applies_to": "the reference window; the measured inputs "
                           "enter the feedback in rad, unscaled"},
-        "simulator": _simulator_record(spring, settings.settings, settings.k_scales),
+        "simulator": _simulator_record(spring, settings.conditions, settings.k_scales),
         "split": {"split": "held_out_speeds", "val_speeds_m_per_s": list(settings.val_speeds)},
         **(record or {}), "training": result.summary(),
     }

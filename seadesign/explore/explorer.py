@@ -34,11 +34,11 @@ from threadpoolctl import threadpool_limits
 
 from seadesign.explore.doe import initial_design, initial_size, pool, unique_rows
 from seadesign.explore.models import Models, fit_models
-from seadesign.explore.problem import (FEASIBLE, MEETS_JUDGED, SOLVED, TOTAL_VIOLATION, VALID, Problem, best_index,
-                                       front_mask, judge)
+from seadesign.explore.problem import (FEASIBLE, MEETS_JUDGED, SOLVED, TOTAL_VIOLATION, VALID, DesignProblem,
+                                       best_index, front_mask, judge)
 from seadesign.explore.search import far_from, propose
-from seadesign.sweep.rank import pareto_front
 from seadesign.explore.stopping import EvaluationBudget, Progress, ScreeningBudget, StalledFront, StopRule, first_reason
+from seadesign.sweep.rank import pareto_front
 
 SURROGATE_THREADS = 1  # BLAS threads while fitting and searching the surrogates: their matrices are small, and
 # more threads made a round slower on busy cores (docs/validation/timing.md)
@@ -94,7 +94,7 @@ def _xframe(X: np.ndarray) -> pd.DataFrame:
 class _State:
     """The growing tables of one run."""
 
-    def __init__(self, problem: Problem, settings: ExplorerSettings) -> None:
+    def __init__(self, problem: DesignProblem, settings: ExplorerSettings) -> None:
         self.problem, self.settings = problem, settings
         d = problem.encoding.dim
         self.evaluated = pd.DataFrame(columns=[f"x{i}" for i in range(d)])
@@ -170,7 +170,7 @@ class Explorer:
     """The explorer of one problem as ask and tell (see the module doc); `jobs` processes fit the surrogates
     (the same models as one), `rules` replace the settings' stop rules."""
 
-    def __init__(self, problem: Problem, settings: ExplorerSettings, jobs: int = 1,
+    def __init__(self, problem: DesignProblem, settings: ExplorerSettings, jobs: int = 1,
                  rules: tuple[StopRule, ...] | None = None) -> None:
         if settings.budget < 2:
             raise ValueError(f"the budget must allow at least 2 full evaluations (got {settings.budget})")
@@ -208,7 +208,7 @@ class Explorer:
                 return None
 
     def tell(self, X: np.ndarray, rows: pd.DataFrame | None) -> None:
-        """The problem's rows (`Problem.evaluate`) for the designs X that `ask` gave (None when it gave none)."""
+        """The problem's rows (`DesignProblem.evaluate`) for the designs X that `ask` gave (None when it gave none)."""
         before = self.state.evaluated.copy()
         if len(X):
             self.state.add(X, rows, self.round_index)
@@ -256,7 +256,7 @@ class Explorer:
                            self.settings.seed + self.round_index, SPARES_PER_DESIGN * want)
 
 
-def explore(problem: Problem, settings: ExplorerSettings, jobs: int = 1) -> Exploration:
+def explore(problem: DesignProblem, settings: ExplorerSettings, jobs: int = 1) -> Exploration:
     """Ask and tell until a stop rule fires (see the module doc); every verified design, the rounds and the
     final models."""
     explorer = Explorer(problem, settings, jobs)

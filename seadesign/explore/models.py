@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import norm
 
-from seadesign.explore.problem import SOLVED, VALID, Problem
+from seadesign.explore.problem import SOLVED, VALID, DesignProblem
 from seadesign.explore.surrogate import FeasibilityClassifier, LooError, Surrogate
 
 
@@ -53,7 +53,7 @@ def _fit(model, X: np.ndarray, y: np.ndarray):
     return model.fit(X, y)
 
 
-def fit_models(problem: Problem, evaluated: pd.DataFrame, screened: pd.DataFrame, seed: int, jobs: int = 1,
+def fit_models(problem: DesignProblem, evaluated: pd.DataFrame, screened: pd.DataFrame, seed: int, jobs: int = 1,
                threads: int = 1) -> Models:
     """Fit every surrogate on the solved designs (a screened column also on every valid screened design)
     and the classifier on every screened design; X columns are the unit-cube coordinates `x0..`. The fits are

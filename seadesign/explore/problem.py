@@ -26,7 +26,7 @@ CONDITIONAL = "conditional"  # optional column: every judged requirement met, so
 MEETS_JUDGED = "meets_judged"  # feasible or conditional: what the search steers by (it models what can be judged)
 
 
-class Problem(Protocol):
+class DesignProblem(Protocol):
     encoding: Encoding
     objectives: tuple[str, ...]  # columns minimised; the first decides the choice among feasible designs
     margins: tuple[str, ...]  # requirement margins (relative, >= 0 met)
@@ -42,7 +42,7 @@ class Problem(Protocol):
     # optional: unjudged(column, X) -> bool mask of the designs where a margin cannot be judged
 
 
-def judge(rows: pd.DataFrame, problem: Problem) -> pd.DataFrame:
+def judge(rows: pd.DataFrame, problem: DesignProblem) -> pd.DataFrame:
     """Rows with TOTAL_VIOLATION (inf where not solved), MEETS_JUDGED (solved, no judged requirement missed) and
     FEASIBLE (that, and not conditional where the problem marks designs whose requirements are not all judged)."""
     t = rows.copy()
