@@ -31,7 +31,7 @@ import numpy as np
 
 from seadesign.fea import rotation_path as rp
 from seadesign.fea.assembly import UpperBlocks
-from seadesign.fea.contact import FacingSurfaces
+from seadesign.fea.facing import FacingSurfaces
 from seadesign.fea.ccx import path_nodes, run_ccx, run_ccx_path, write_load_case_decks, write_path_inp
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.loadcases import analyse

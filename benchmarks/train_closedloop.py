@@ -31,8 +31,8 @@ import numpy as np
 import torch
 
 from seadesign import __version__
-from seadesign.corrector.closedloop_training import (FINE_TUNING, ClosedLoopResult, ClosedLoopSettings, runtime_corrector,
-                                                     train_closed_loop)
+from seadesign.corrector.closedloop_policy import runtime_corrector
+from seadesign.corrector.closedloop_training import FINE_TUNING, ClosedLoopResult, ClosedLoopSettings, train_closed_loop
 from seadesign.corrector.export import load_meta, load_numpy, load_torchscript
 from seadesign.corrector.pipeline import CAPS_S, capped_reference_settings
 from seadesign.corrector.reference import Preview

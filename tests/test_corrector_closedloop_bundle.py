@@ -10,8 +10,8 @@ import torch
 from conftest import REPO, require_module, thesis_spring
 
 from seadesign.corrector.closedloop import run_closed_loop
-from seadesign.corrector.closedloop_training import (MEASURED_INPUTS, ClosedLoopSettings, runtime_corrector,
-                                                     train_closed_loop)
+from seadesign.corrector.closedloop_policy import MEASURED_INPUTS, runtime_corrector
+from seadesign.corrector.closedloop_training import ClosedLoopSettings, train_closed_loop
 from seadesign.corrector.export import load_meta, load_numpy, load_torchscript
 from seadesign.corrector.reference import reference_features
 from seadesign.corrector.runtime import ClosedLoopCorrector

@@ -12,9 +12,9 @@ import torch
 from conftest import thesis_spring
 
 from seadesign.corrector.closedloop import closed_loop_table, run_closed_loop
-from seadesign.corrector.closedloop_training import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, ClosedLoopPolicy,
-                                                     ClosedLoopSettings, FeedbackBranch, _batch, runtime_corrector,
-                                                     train_closed_loop, window_policy)
+from seadesign.corrector.closedloop_policy import (FEEDBACK_LIPSCHITZ_RAD_PER_RAD, ClosedLoopPolicy, FeedbackBranch,
+                                                   runtime_corrector)
+from seadesign.corrector.closedloop_training import ClosedLoopSettings, _batch, train_closed_loop, window_policy
 from seadesign.corrector.goal import goal_table
 from seadesign.corrector.reference import Preview, ReferenceBuffer, ReferenceWindow, reference_features
 from seadesign.corrector.runtime import FeedForward, HallPI, NoCorrection

@@ -12,7 +12,8 @@ from helpers_neo_hooke import neo_hooke_cauchy, uniaxial
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import ConfigError
-from seadesign.fea.contact import ContactSettings, ContactSurface, FrictionlessContact, Multipliers, plane_gap
+from seadesign.fea.contact import ContactSettings, ContactSurface, FrictionlessContact, Multipliers
+from seadesign.fea.contact_geometry import plane_gap
 from seadesign.fea.elements import element_mesh, midside_nodes
 from seadesign.fea.equilibrium import Equilibrium
 from seadesign.fea.finite_strain import Solid

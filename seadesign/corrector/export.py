@@ -207,7 +207,7 @@ class NumpyCorrector:
 class NumpyClosedLoop:
     """A policy trained through the closed loop (`closedloop_training`) in NumPy (float64):
     command = ff(x) + L [h(m, x) - h(0, x)] (rad, flexion) from the reference window x (d) and the measured
-    inputs m (2, rad); arrays from `closedloop_training.policy_arrays` (standardisation folded in)."""
+    inputs m (2, rad); arrays from `closedloop_policy.policy_arrays` (standardisation folded in)."""
 
     def __init__(self, arrays: dict[str, np.ndarray]) -> None:
         a = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}

@@ -18,8 +18,8 @@ import pandas as pd
 from seadesign.corrector.closedloop import closed_loop_table
 from seadesign.corrector.dataset import KNEES, CorrectorDataset, DatasetSpec, Recording, build_dataset
 from seadesign.corrector.evaluate import open_loop_table
-from seadesign.corrector.closedloop_training import (FINE_TUNING, MEASURED_INPUTS, RATE_TIME_S, ClosedLoopResult,
-                                                     ClosedLoopSettings, FlatPolicy, policy_arrays, train_closed_loop)
+from seadesign.corrector.closedloop_policy import MEASURED_INPUTS, RATE_TIME_S, FlatPolicy, policy_arrays
+from seadesign.corrector.closedloop_training import FINE_TUNING, ClosedLoopResult, ClosedLoopSettings, train_closed_loop
 from seadesign.corrector.export import export_bundle, input_list, load_meta, load_numpy, normalisation, versions
 from seadesign.corrector.modalities import COMBINATIONS
 from seadesign.corrector.recordings import load_recordings

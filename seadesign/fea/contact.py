@@ -1,9 +1,7 @@
-"""Surfaces of a part that face each other across open space, and the gap between them as it deforms.
-
-Two boundary vertices face each other when their outward normals are opposed (cosine below -0.5), they
-lie within the search distance (a k-d tree of the deformed positions, rebuilt at each state) and they
-faced each other across open space at rest (a positive gap then: not the two sides of a thin wall). The
-gap is their separation along the normals, negative once they overlap. Positions in m, gaps reported in mm.
+"""Frictionless self-contact of a part's boundary (quadratic tetrahedral meshes): the Gauss points of its 6-node
+faces against flat facets, each pair's gap and its exact derivatives, and the contact as an energy enforced by an
+augmented Lagrangian (`ContactSettings`, `FrictionlessContact`); the search's first pass is over the facing
+vertices (`fea.facing`). Positions in m, pressures in Pa.
 """
 
 from __future__ import annotations
@@ -14,80 +12,12 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from seadesign.errors import ConfigError, SolverError
+from seadesign.fea.contact_geometry import FACE_POINTS, FACE_WEIGHTS, SUBFACETS, face_shape_values, plane_gap
 from seadesign.fea.elements import ElementMesh, midside_nodes
+from seadesign.fea.facing import FacingSurfaces
 from seadesign.fea.torsion import MM
 
 
-@dataclass(frozen=True)
-class FacingSurfaces:
-    """The boundary of a mesh for the gap search: its vertices, linear facets and outward normals at rest."""
-
-    nodes_m: np.ndarray  # (N, 3) all nodes at rest
-    vertices: np.ndarray  # boundary vertices (node ids)
-    faces: np.ndarray  # (k, 3) boundary facets (node ids)
-    rest_normals: np.ndarray  # (len(vertices), 3) outward unit normals at rest
-    search_m: float  # vertices further apart are never paired
-
-    @classmethod
-    def of(cls, nodes_m: np.ndarray, faces: np.ndarray, search_mm: float) -> "FacingSurfaces":
-        vertices = np.unique(faces)
-        return cls(nodes_m, vertices, faces, vertex_normals(nodes_m, faces, vertices), search_mm * MM)
-
-    def min_gap_mm(self, u: np.ndarray) -> tuple[float, tuple[float, float, float]]:
-        """Smallest gap (mm) between facing vertices of the part deformed by u (m), and where (the pair's
-        midpoint at rest, mm); inf and NaN without a facing pair within the search distance."""
-        x0 = self.nodes_m[self.vertices]
-        x = x0 + u[self.vertices]
-        n = vertex_normals(self.nodes_m + u, self.faces, self.vertices)
-        pairs = self._pairs(x, n, self.search_m, -0.5)
-        if not len(pairs):
-            return float("inf"), (float("nan"),) * 3
-        gaps = _gap(x, n, pairs)
-        k = int(np.argmin(gaps))
-        return float(gaps[k] / MM), tuple(float(c) for c in x0[pairs[k]].mean(axis=0) / MM)
-
-    def facing_vertices(self, u: np.ndarray, distance_m: float, cosine: float) -> np.ndarray:
-        """The vertices (node ids) within `distance_m` of a vertex they face at u (normals' cosine below `cosine`,
-        a positive gap at rest)."""
-        x = self.nodes_m[self.vertices] + u[self.vertices]
-        return self.vertices[np.unique(self._pairs(x, vertex_normals(self.nodes_m + u, self.faces, self.vertices),
-                                                   distance_m, cosine))]
-
-    def _pairs(self, x: np.ndarray, n: np.ndarray, distance_m: float, cosine: float) -> np.ndarray:
-        """Vertex pairs (rows of `vertices`) within `distance_m` at positions x, normals n, that face each other."""
-        pairs = cKDTree(x).query_pairs(distance_m, output_type="ndarray")
-        if len(pairs):
-            pairs = pairs[np.einsum("ij,ij->i", n[pairs[:, 0]], n[pairs[:, 1]]) < cosine]
-        if len(pairs):
-            pairs = pairs[_gap(self.nodes_m[self.vertices], self.rest_normals, pairs) > 0]
-        return pairs
-
-
-def vertex_normals(x: np.ndarray, faces: np.ndarray, vertices: np.ndarray) -> np.ndarray:
-    """Unit outward normals (area-weighted) of the boundary vertices at positions x."""
-    tri = x[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    vn = np.zeros_like(x)
-    for k in range(3):
-        np.add.at(vn, faces[:, k], normal)
-    return vn[vertices] / np.linalg.norm(vn[vertices], axis=1)[:, None]
-
-
-def _gap(x: np.ndarray, n: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-    """Separation of vertex pairs along their normals (m); positive across open space, negative through material."""
-    d = x[pairs[:, 1]] - x[pairs[:, 0]]
-    return 0.5 * np.einsum("ij,ij->i", d, n[pairs[:, 0]] - n[pairs[:, 1]])
-
-
-# --- frictionless contact: Gauss points of the quadratic boundary faces against flat facets -------------------------
-
-# The quadratic boundary face (corners 0-2, then the midsides of edges 01, 12, 20) split into four flat facets
-SUBFACETS = np.array([[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]])
-# Dunavant's 6-point rule on the triangle (degree 4): barycentric points and weights summing to 1
-_A, _B = 0.445948490915965, 0.091576213509771
-FACE_POINTS = np.array([[_A, _A, 1 - 2 * _A], [_A, 1 - 2 * _A, _A], [1 - 2 * _A, _A, _A],
-                        [_B, _B, 1 - 2 * _B], [_B, 1 - 2 * _B, _B], [1 - 2 * _B, _B, _B]])
-FACE_WEIGHTS = np.array([0.223381589678011] * 3 + [0.109951743655322] * 3)
 # A point faces a facet when the cosine between its face's normal and the facet's is below this (more than 107
 # degrees apart): surfaces that close on each other meet nearly opposed; a wall beside a flat face (90 degrees)
 # is not paired with it, which keeps the search from pairing every side-wall point with the large top and
@@ -96,45 +26,6 @@ FACING_COSINE = -0.3
 # The search's first pass pairs vertices whose (averaged) normals are more than 60 degrees apart: at an edge or
 # a corner a vertex's normal leans half-way to the side wall's
 NEAR_COSINE = 0.5
-
-
-def face_shape_values(lam: np.ndarray) -> np.ndarray:
-    """Quadratic triangle shape functions (q, 6) at barycentric points lam (q, 3): corners, then midsides 01, 12, 20."""
-    l0, l1, l2 = lam.T
-    return np.column_stack([l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1), 4 * l0 * l1, 4 * l1 * l2, 4 * l2 * l0])
-
-
-def _cross_matrix(v: np.ndarray) -> np.ndarray:
-    """[v]x (..., 3, 3): [v]x w = v x w."""
-    z = np.zeros(v.shape[:-1])
-    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], z, -v[..., 0]], -1),
-                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
-
-
-def plane_gap(d: np.ndarray, e1: np.ndarray, e2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The signed distance g = d . n of points from the planes of facets (P,), n = e1 x e2 / |e1 x e2|, with d the
-    point minus the facet's first corner and e1, e2 its edges from there (P, 3, m); and its gradient (P, 3, 3) and
-    Hessian (P, 3, 3, 3, 3) in the variables (d, e1, e2): [variable, component] and
-    [variable, variable, component, component]."""
-    m = np.cross(e1, e2)
-    a = np.linalg.norm(m, axis=1)
-    n = m / a[:, None]
-    g = np.einsum("pi,pi->p", d, n)
-    p = (d - g[:, None] * n) / a[:, None]  # dg/dm
-    grad = np.stack([n, np.cross(e2, p), np.cross(p, e1)], axis=1)
-    proj = np.eye(3) - n[:, :, None] * n[:, None, :]
-    h_mm = -(n[:, :, None] * p[:, None, :] + p[:, :, None] * n[:, None, :]) / a[:, None, None] \
-        - g[:, None, None] * proj / (a**2)[:, None, None]
-    j1, j2 = -_cross_matrix(e2), _cross_matrix(e1)  # dm/de1, dm/de2
-    h_dm = proj / a[:, None, None]
-    hess = np.zeros((len(g), 3, 3, 3, 3))
-    hess[:, 0, 1], hess[:, 0, 2] = h_dm @ j1, h_dm @ j2
-    hess[:, 1, 0], hess[:, 2, 0] = np.swapaxes(hess[:, 0, 1], 1, 2), np.swapaxes(hess[:, 0, 2], 1, 2)
-    hess[:, 1, 1] = np.swapaxes(j1, 1, 2) @ h_mm @ j1
-    hess[:, 2, 2] = np.swapaxes(j2, 1, 2) @ h_mm @ j2
-    hess[:, 1, 2] = np.swapaxes(j1, 1, 2) @ h_mm @ j2 - _cross_matrix(p)
-    hess[:, 2, 1] = np.swapaxes(hess[:, 1, 2], 1, 2)
-    return g, grad, hess
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,7 @@ import numpy as np
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import NotPositiveDefinite, SolverError
-from seadesign.fea.contact import FacingSurfaces
+from seadesign.fea.facing import FacingSurfaces
 from seadesign.fea.elements import element_mesh
 from seadesign.fea.equilibrium import Equilibrium
 from seadesign.fea.finite_strain import Solid
