@@ -183,11 +183,11 @@ def test_gradcheck_of_a_short_rollout(spring_dict, options):
     saved = knee.state()
 
     def from_state(angle, vel):
-        knee.load_state({**saved, "angle": angle, "vel": vel})
+        knee.load_state(dataclasses.replace(saved, angle_rad=angle, velocity_rad_per_s=vel))
         out = rollout(knee, lambda obs, k: target[:, k], stance, 4)
         return torch.cat([out["hall_rad"], out["effort_Nm"]], dim=1)
-    assert torch.autograd.gradcheck(from_state, (saved["angle"].clone().requires_grad_(True),
-                                                 saved["vel"].clone().requires_grad_(True)))
+    assert torch.autograd.gradcheck(from_state, (saved.angle_rad.clone().requires_grad_(True),
+                                                 saved.velocity_rad_per_s.clone().requires_grad_(True)))
 
 
 def test_gradients_of_a_full_rollout_are_finite_and_exact(spring_dict):
@@ -232,7 +232,7 @@ def test_a_window_from_a_saved_state_continues_the_full_rollout(spring_dict):
     assert knee.observe().hall_rad.shape == (4, 2)
     ((window["hall_rad"] - target[:, 200:300]) ** 2).mean().backward()
     assert torch.isfinite(offset.grad).all() and offset.grad.abs().min() > 0
-    assert all(not t.requires_grad for t in (saved["qm"], saved["angle"], saved["effects"]["hysteresis"]["z"]))
+    assert all(not t.requires_grad for t in (saved.motor_rad, saved.angle_rad, saved.effects["hysteresis"]["z"]))
 
 
 def test_noise_has_the_chains_std_and_quantisation_is_straight_through(spring_dict):

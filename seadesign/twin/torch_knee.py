@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 import zlib
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Callable
 
 import numpy as np
@@ -81,6 +81,25 @@ class TorchObservation:
     motor_velocity_rad_per_s: Tensor
     hall_velocity_rad_per_s: Tensor
     effort_Nm: Tensor
+
+
+@dataclass
+class TorchKneeState:
+    """The torch knee between samples: tensors of the batch shape (..., 2), flexion frame. `state()` gives a
+    detached copy (a window's start for truncated backpropagation) with the noise streams' states."""
+
+    motor_rad: Tensor
+    motor_velocity_rad_per_s: Tensor
+    angle_rad: Tensor
+    velocity_rad_per_s: Tensor
+    spring_torque_Nm: Tensor
+    load_torque_Nm: Tensor
+    effects: dict[str, dict[str, Tensor]]  # each stateful effect's state, by effect name
+    previous_hall_rad: Tensor | None  # the last sample's Hall reading (its finite difference is hall velocity)
+    sample: int  # samples since reset
+    time_s: float
+    observation: TorchObservation | None = None
+    generators: dict[str, Tensor] = field(default_factory=dict)  # noise streams' states, in a `state()` copy
 
 
 # -- effects in torch ---------------------------------------------------------------------------------------
@@ -388,7 +407,7 @@ class TorchKnee:
         ops = [_build_op(e, self.options) for e in effects.enabled()]
         self.stages = {t: [op for op in ops if op.target == t] for t in PHYSICS + SENSORS}
         self.needs_stance = any("stance" in op.reads() for op in ops)
-        self._s: dict[str, Any] | None = None
+        self._state: TorchKneeState | None = None
 
     @classmethod
     def from_session(cls, session: KneeSession, **options: Any) -> "TorchKnee":
@@ -458,24 +477,24 @@ class TorchKnee:
         self.options.generators.clear()
         if seed is not None:
             self.options.seed = int(seed)
-        self._s = {"qm": q0, "omega": zero, "vel": zero, "angle": angle, "spring_torque": torque,
-                   "load_torque": load, "effects": states, "prev_hall": None, "step": 0, "time_s": 0.0}
+        self._state = TorchKneeState(q0, zero, angle, zero, torque, load, states, None, 0, 0.0)
         return self._sense()
 
     def step(self, command_flex_rad: Tensor, stance: Any = None) -> TorchObservation:
         """Send the motor position command (rad, flexion frame, batch shape) for one sample period (all
         substeps), legs carrying `stance` over it; return the next sample's observation."""
-        s = self._require()
+        state = self._require()
         cmd = self.tensor(command_flex_rad)
-        if torch.broadcast_shapes(cmd.shape, s["qm"].shape) != s["qm"].shape:
-            raise ConfigError(f"command of shape {tuple(cmd.shape)} does not fit the knees' {tuple(s['qm'].shape)}")
-        stance_t = self._stance(stance, s["qm"])
+        if torch.broadcast_shapes(cmd.shape, state.motor_rad.shape) != state.motor_rad.shape:
+            raise ConfigError(f"command of shape {tuple(cmd.shape)} does not fit the knees' "
+                              f"{tuple(state.motor_rad.shape)}")
+        stance_t = self._stance(stance, state.motor_rad)
         cfg = self.config
         h = self.dt / self.n_sub
         limit, stall, w0 = cfg.torque_limit, cfg.stall_torque_Nm, cfg.no_load_speed_rad_per_s
         inv_j = 1.0 / cfg.link_inertia_kg_m2
-        qm, vel, angle, omega = s["qm"], s["vel"], s["angle"], s["omega"]
-        torque, load, states, t = s["spring_torque"], s["load_torque"], s["effects"], s["time_s"]
+        qm, vel, angle = state.motor_rad, state.velocity_rad_per_s, state.angle_rad
+        torque, load, states, t = state.spring_torque_Nm, state.load_torque_Nm, state.effects, state.time_s
         for _ in range(self.n_sub):
             u = torch.clamp(cfg.p_gain_Nm_per_rad * (cmd - qm), -limit, limit)
             omega = torch.clamp(w0 * (u - torque) / stall, -w0, w0)
@@ -484,40 +503,48 @@ class TorchKnee:
             angle = angle + vel * h
             t += h
             torque, load, states = self._torques(qm, angle, vel, stance_t, t, states, h)
-        s.update(qm=qm, omega=omega, vel=vel, angle=angle, spring_torque=torque, load_torque=load,
-                 effects=states, time_s=t, step=s["step"] + 1)
+        self._state = replace(state, motor_rad=qm, motor_velocity_rad_per_s=omega, velocity_rad_per_s=vel,
+                              angle_rad=angle, spring_torque_Nm=torque, load_torque_Nm=load, effects=states,
+                              time_s=t, sample=state.sample + 1)
         return self._sense()
 
     def _sense(self) -> TorchObservation:
-        s = self._s
-        sig: Sig = {"time": s["step"] * self.dt, "hall": s["angle"], "motor": s["qm"], "effort": s["spring_torque"],
-                    "motor_velocity": s["omega"]}
-        states = dict(s["effects"])
+        state = self._state
+        sig: Sig = {"time": state.sample * self.dt, "hall": state.angle_rad, "motor": state.motor_rad,
+                    "effort": state.spring_torque_Nm, "motor_velocity": state.motor_velocity_rad_per_s}
+        states = dict(state.effects)
         for target in SENSORS:
             for op in self.stages[target]:
-                sig[target], state = op(sig, states.get(op.name, {}), self.dt)
+                sig[target], effect_state = op(sig, states.get(op.name, {}), self.dt)
                 if op.stateful:
-                    states[op.name] = state
-        s["effects"] = states
+                    states[op.name] = effect_state
+        state.effects = states
         hall = sig["hall"]
-        hall_vel = torch.zeros_like(hall) if s["prev_hall"] is None else (hall - s["prev_hall"]) / self.dt
-        s["prev_hall"] = hall
-        s["obs"] = TorchObservation(hall, sig["motor"], s["omega"], hall_vel, sig["effort"])
-        return s["obs"]
+        previous = state.previous_hall_rad
+        hall_vel = torch.zeros_like(hall) if previous is None else (hall - previous) / self.dt
+        state.previous_hall_rad = hall
+        state.observation = TorchObservation(hall, sig["motor"], state.motor_velocity_rad_per_s, hall_vel,
+                                             sig["effort"])
+        return state.observation
 
     def observe(self) -> TorchObservation:
         """The current sample's observation (the one `reset` or the last `step` returned)."""
-        return self._require()["obs"]
+        return self._require().observation
+
+    @property
+    def sample_index(self) -> int:
+        """Samples since `reset` (the index of the sample `observe` returns)."""
+        return self._require().sample
 
     # -- windows -------------------------------------------------------------------------------------------
-    def _require(self) -> dict[str, Any]:
-        if self._s is None:
+    def _require(self) -> TorchKneeState:
+        if self._state is None:
             raise ConfigError("the torch knee has no state; call reset(flexion) or load_state(state) first")
-        return self._s
+        return self._state
 
-    def state(self) -> dict[str, Any]:
-        """The current state, detached (a window's start for truncated backpropagation): tensors, the sample
-        index and time (s), and the noise streams."""
+    def state(self) -> TorchKneeState:
+        """The current state, detached (a window's start for truncated backpropagation), with the noise streams'
+        states."""
         def detach(x: Any) -> Any:
             if isinstance(x, Tensor):
                 return x.detach().clone()
@@ -526,18 +553,17 @@ class TorchKnee:
             if isinstance(x, TorchObservation):
                 return TorchObservation(*(detach(getattr(x, f.name)) for f in fields(x)))
             return x
-        out = detach(self._require())
-        out["generators"] = {name: g.get_state() for name, g in self.options.generators.items()}
-        return out
+        current = self._require()
+        return TorchKneeState(**{f.name: detach(getattr(current, f.name)) for f in fields(current)
+                                 if f.name != "generators"},
+                              generators={name: g.get_state() for name, g in self.options.generators.items()})
 
-    def load_state(self, state: dict[str, Any]) -> None:
+    def load_state(self, state: TorchKneeState) -> None:
         """Continue from `state` (from `state()`; its tensors may require grad to differentiate w.r.t. it)."""
-        state = dict(state)
-        streams = state.pop("generators", {})
         self.options.generators.clear()
-        for name, g_state in streams.items():
+        for name, g_state in state.generators.items():
             self.options.generator(name).set_state(g_state)
-        self._s = {**state, "effects": {k: dict(v) for k, v in state["effects"].items()}}
+        self._state = replace(state, effects={k: dict(v) for k, v in state.effects.items()}, generators={})
 
 
 # -- protocol and rollout ------------------------------------------------------------------------------------
@@ -559,7 +585,7 @@ def rollout(knee: TorchKnee, policy: Policy, stance: Tensor | None, n_steps: int
     names = tuple(f.name for f in fields(TorchObservation))
     log: dict[str, list[Tensor]] = {f: [] for f in names + ("command_rad",)}
     for _ in range(n_steps):
-        k = knee._require()["step"]
+        k = knee.sample_index
         cmd = policy(obs, k)
         for f in names:
             log[f].append(getattr(obs, f))
