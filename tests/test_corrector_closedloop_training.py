@@ -232,8 +232,8 @@ def test_training_batch_runs_each_row_at_its_stiffness_and_tells_the_policy_spri
     b.knee.reset(b.target[:, 0], b.stance[:, 0])
     state = b.knee.state()
     cfg = KneeConfig.from_spring(spring)
-    beyond = (state["qm"] - state["angle"]).abs().numpy() - 0.5 * cfg.backlash_rad  # (rows, 2), flexion
-    gravity = np.abs(cfg.gravity_amplitude_Nm * np.sin(state["angle"].numpy() - cfg.hip_flexion_rad))
+    beyond = (state.motor_rad - state.angle_rad).abs().numpy() - 0.5 * cfg.backlash_rad  # (rows, 2), flexion
+    gravity = np.abs(cfg.gravity_amplitude_Nm * np.sin(state.angle_rad.numpy() - cfg.hip_flexion_rad))
     for group, scale in enumerate((0.8, 1.25)):  # the hanging rows
         rows = slice(group * n, (group + 1) * n)
         np.testing.assert_allclose(cfg.k_Nm_per_rad * scale * beyond[rows], gravity[rows], rtol=1e-12)

@@ -180,20 +180,21 @@ def _path(data: LoopData, d: np.ndarray) -> np.ndarray:
 
 def _torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
     """Stiffness direction: deflection -> (sensor undone) -> dead-band -> spring law -> + loads."""
-    s = data.signals
+    signals = data.signals
     spring = data.spring is not None  # a spring's deflection input is read through the smoother
-    d0 = data.smooth("deflection") if spring else s.get("deflection")
+    d0 = data.smooth("deflection") if spring else signals.get("deflection")
     path0 = data.predicted if data.predicted is not None else _path(data, d0)
-    d, path = d0, path0
+    deflection, path = d0, path0
     if data.sensor_on == "deflection" and at["sensor"]:
-        d = _sensor_inverse(data, at["sensor"], values, s["deflection"])
-        d = data.smoothed(d) if spring else d
-        path = path0 + _path(data, d) - _path(data, d0)
+        deflection = _sensor_inverse(data, at["sensor"], values, signals["deflection"])
+        deflection = data.smoothed(deflection) if spring else deflection
+        path = path0 + _path(data, deflection) - _path(data, d0)
     for t in at["deflection"]:
-        banded = t.effect.evaluate({"deflection": d}, values[t.name])
-        path, d = path + _path(data, banded) - _path(data, d), banded
+        banded = t.effect.evaluate({"deflection": deflection}, values[t.name])
+        path, deflection = path + _path(data, banded) - _path(data, deflection), banded
     stateful = {"hysteresis", "viscoelastic", "thermal_softening"} & {t.key for t in at["spring"]}
-    ds = None if not stateful else d if spring else data.smoothed(d) if d is not d0 else data.smooth("deflection")
+    ds = None if not stateful else deflection if spring else \
+        data.smoothed(deflection) if deflection is not d0 else data.smooth("deflection")
     tau, factor = path, 1.0
     scale = next((values[t.name]["scale"] for t in at["spring"] if t.key == "stiffness_scale"), 1.0)
     for t in at["spring"]:
@@ -201,21 +202,21 @@ def _torque(data: LoopData, at: dict[str, list[Term]], values) -> np.ndarray:
         if t.key == "stiffness_scale":
             tau = tau * p["scale"]
         elif t.key in LAW_SHAPES:
-            tau = tau + scale * t.effect.shape_torque(d, p[t.effect.parameters[0].name])
+            tau = tau + scale * t.effect.shape_torque(deflection, p[t.effect.parameters[0].name])
         elif t.key == "cubic_stiffening":
-            tau = tau + p["k3_Nm_per_rad3"] * d ** 3
+            tau = tau + p["k3_Nm_per_rad3"] * deflection ** 3
         elif t.key == "hysteresis":
             tau = tau + dahl(ds, p["torque_Nm"], p["stiffness_Nm_per_rad"])
         elif t.key == "viscoelastic":  # k2 (d - relaxed): the relaxed state from the smoothed deflection
             arm = t.effect.evaluate({"deflection": ds, "time": data.time, "torque": np.zeros_like(ds)}, p)
-            tau = tau + arm + p["maxwell_stiffness_Nm_per_rad"] * (d - ds)
+            tau = tau + arm + p["maxwell_stiffness_Nm_per_rad"] * (deflection - ds)
         elif t.key == "thermal_softening":
             factor = factor * _thermal_factor(data, p, lambda: path * np.diff(ds, prepend=ds[0]))
         else:  # temperature_softening
-            factor = factor * t.effect.evaluate({"temperature": s["temperature"], "torque": np.ones(data.n)}, p)
+            factor = factor * t.effect.evaluate({"temperature": signals["temperature"], "torque": np.ones(data.n)}, p)
     y = tau * factor + ((data.predicted - path0) if data.predicted is not None else 0.0)
     for t in at["load"]:
-        y = t.effect.evaluate({**s, "load_torque": y}, values[t.name])
+        y = t.effect.evaluate({**signals, "load_torque": y}, values[t.name])
     return y
 
 

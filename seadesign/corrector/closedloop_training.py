@@ -150,23 +150,23 @@ class _Batch:
     val_rows: torch.Tensor
 
 
-def _batch(spring: dict, s: ClosedLoopSettings) -> _Batch:
+def _batch(spring: dict, settings: ClosedLoopSettings) -> _Batch:
     """Rows: for each setting and k scale, the training then the validation trials. The knee's stiffness is
     scaled per row; the policy's k input stays spring.json's (the corrector is not told the robot's k)."""
-    train, val = s.trials(s.speeds), s.trials(s.val_speeds)
-    _, target, stance = protocol_tensors(train + val, s.rate_hz, s.gait)
-    n, groups = len(train) + len(val), [(st, scale) for st in s.conditions for scale in s.k_scales]
+    train, val = settings.trials(settings.speeds), settings.trials(settings.val_speeds)
+    _, target, stance = protocol_tensors(train + val, settings.rate_hz, settings.gait)
+    n, groups = len(train) + len(val), [(st, scale) for st in settings.conditions for scale in settings.k_scales]
     target = target.repeat(len(groups), 1, 1)
     ground = torch.tensor([float(st == "ground") for st, _ in groups]).repeat_interleave(n)
     scale = torch.tensor([scale for _, scale in groups], dtype=torch.float64).repeat_interleave(n)
     stance = stance.repeat(len(groups), 1, 1) * ground[:, None, None]
     k = float(spring["k_Nm_per_rad"])
-    feats = reference_features(np.moveaxis(target.numpy(), 2, 1), np.moveaxis(stance.numpy(), 2, 1), k, s.window)
+    feats = reference_features(np.moveaxis(target.numpy(), 2, 1), np.moveaxis(stance.numpy(), 2, 1), k, settings.window)
     rows = torch.arange(len(target))
     is_val = (rows % n) >= len(train)
     config = KneeConfig.from_spring(spring)
     knee = TorchKnee(config, knee_effects(config, ground=True).configure("stiffness_scale", enabled=True),
-                     rate_hz=s.rate_hz, noise=s.noise, seed=s.seed)
+                     rate_hz=settings.rate_hz, noise=settings.noise, seed=settings.seed)
     knee.vary("stiffness_scale", scale=scale[:, None])
     return _Batch(knee, target, stance, torch.as_tensor(np.moveaxis(feats, 1, 2), dtype=torch.float32),
                   rows[~is_val], rows[is_val])
@@ -228,29 +228,30 @@ def train_closed_loop(spring: dict, settings: ClosedLoopSettings = ClosedLoopSet
         torch.set_num_threads(threads_before)
 
 
-def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> ClosedLoopResult:
+def _train(spring: dict, settings: ClosedLoopSettings, init: CorrectorNet | None) -> ClosedLoopResult:
     t0 = time.perf_counter()
-    b = _batch(spring, s)
-    opts = {"hidden": s.hidden, "layers": s.layers, "lipschitz_rad_per_rad": s.lipschitz_rad_per_rad}
+    batch = _batch(spring, settings)
+    opts = {"hidden": settings.hidden, "layers": settings.layers,
+            "lipschitz_rad_per_rad": settings.lipschitz_rad_per_rad}
     if init is None:
-        policy = ClosedLoopPolicy.from_scratch(b.features[b.train_rows].reshape(-1, b.features.shape[-1]).numpy(),
-                                               s.window, s.seed, **opts)
+        training_features = batch.features[batch.train_rows].reshape(-1, batch.features.shape[-1]).numpy()
+        policy = ClosedLoopPolicy.from_scratch(training_features, settings.window, settings.seed, **opts)
     else:
-        policy = ClosedLoopPolicy.from_feedforward(init, s.window, s.seed, **opts)
-    opt = torch.optim.Adam(policy.parameters(), lr=s.lr)
-    gen = torch.Generator().manual_seed(s.seed)
-    n_steps = b.target.shape[1]
-    n_windows = -(-n_steps // s.window_steps)
-    target_val = b.target[b.val_rows].numpy()
+        policy = ClosedLoopPolicy.from_feedforward(init, settings.window, settings.seed, **opts)
+    opt = torch.optim.Adam(policy.parameters(), lr=settings.lr)
+    gen = torch.Generator().manual_seed(settings.seed)
+    n_steps = batch.target.shape[1]
+    n_windows = -(-n_steps // settings.window_steps)
+    target_val = batch.target[batch.val_rows].numpy()
     curve: list[dict] = []
-    stop, best_state, stopped = KeepBest(s.patience, s.min_improvement), None, "max_epochs"
+    stop, best_state, stopped = KeepBest(settings.patience, settings.min_improvement), None, "max_epochs"
     simulated = trained = 0
-    for epoch in range(s.max_epochs + 1):
+    for epoch in range(settings.max_epochs + 1):
         policy.eval()
-        starts, log = _record(policy, b, s.window_steps)
+        starts, log = _record(policy, batch, settings.window_steps)
         simulated += n_steps
-        val_err = float(np.mean(np.abs(target_val - log["hall"][b.val_rows.numpy()])))
-        chatter = float(np.nanmax(chatter_rms(log["command"][b.val_rows.numpy()], target_val, s.rate_hz)))
+        val_err = float(np.mean(np.abs(target_val - log["hall"][batch.val_rows.numpy()])))
+        chatter = float(np.nanmax(chatter_rms(log["command"][batch.val_rows.numpy()], target_val, settings.rate_hz)))
         calm = chatter < 0.5 * CHATTER_RMS_RAD
         row = {"epoch": epoch, "val_mean_abs_error_rad": val_err, "val_rest_chatter_rad": chatter,
                "train_loss": float("nan"), "bptt_s": 0.0, "elapsed_s": time.perf_counter() - t0}
@@ -259,28 +260,29 @@ def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> Cl
             best_state = copy.deepcopy(policy.state_dict())
         if not stop.improved:
             for group in opt.param_groups:
-                group["lr"] *= s.lr_decay
+                group["lr"] *= settings.lr_decay
         if stop.exhausted:
             stopped = "patience"
             break
-        if epoch == s.max_epochs:
+        if epoch == settings.max_epochs:
             break
-        if time.perf_counter() - t0 > s.max_seconds:
+        if time.perf_counter() - t0 > settings.max_seconds:
             stopped = "time_limit"
             break
         policy.train()
         losses, t_bptt = [], time.perf_counter()
-        for w in torch.randperm(n_windows, generator=gen)[: s.windows_per_epoch or n_windows].tolist():
-            k0 = w * s.window_steps
-            steps = min(s.window_steps, n_steps - k0)
-            b.knee.load_state(starts[w])
+        for w in torch.randperm(n_windows, generator=gen)[: settings.windows_per_epoch or n_windows].tolist():
+            k0 = w * settings.window_steps
+            steps = min(settings.window_steps, n_steps - k0)
+            batch.knee.load_state(starts[w])
             opt.zero_grad(set_to_none=True)
             with parametrize.cached():
-                out = rollout(b.knee, window_policy(policy, b.features, b.target, k0, steps, b.knee.dt), b.stance,
-                              steps)
-                loss = _window_loss(out, b.target[:, k0: k0 + steps], b.train_rows, b.knee.dt, s.rate_weight_s2)
+                window = window_policy(policy, batch.features, batch.target, k0, steps, batch.knee.dt)
+                out = rollout(batch.knee, window, batch.stance, steps)
+                loss = _window_loss(out, batch.target[:, k0: k0 + steps], batch.train_rows, batch.knee.dt,
+                                    settings.rate_weight_s2)
                 loss.backward()
-            nn.utils.clip_grad_norm_(policy.parameters(), s.grad_clip)
+            nn.utils.clip_grad_norm_(policy.parameters(), settings.grad_clip)
             opt.step()
             losses.append(loss.item())
             simulated += steps
@@ -292,4 +294,5 @@ def _train(spring: dict, s: ClosedLoopSettings, init: CorrectorNet | None) -> Cl
                              "lower lipschitz_rad_per_rad or raise rate_weight_s2")
     policy.load_state_dict(best_state)
     policy.eval()
-    return ClosedLoopResult(policy, s, curve, stop.best_epoch, stopped, time.perf_counter() - t0, simulated, trained)
+    return ClosedLoopResult(policy, settings, curve, stop.best_epoch, stopped, time.perf_counter() - t0, simulated,
+                            trained)

@@ -38,7 +38,7 @@ def beam_clearance_mm(part: Part) -> float:
 
 def check(part: Part, rules: ValidityRules) -> list[str]:
     """All reasons the candidate is invalid; an empty list means valid."""
-    p = part.params
+    params = part.params
     reasons: list[str] = list(part.errors)
     clearance = beam_clearance_mm(part)
     if clearance < rules.min_clearance_mm:
@@ -68,20 +68,20 @@ def check(part: Part, rules: ValidityRules) -> list[str]:
                            f"{rules.min_feature_mm:g} mm and would fuse when printed")
             break
 
-    t = p.thickness_mm
-    for side, pattern in (("hub", p.hub_bolts), ("ring", p.ring_bolts)):
+    t = params.thickness_mm
+    for side, pattern in (("hub", params.hub_bolts), ("ring", params.ring_bolts)):
         radius = max(pattern.hole_diameter_mm, pattern.counterbore_diameter_mm) / 2
         for k, hole in enumerate(pattern.holes()):
             rc = math.hypot(hole.x_mm, hole.y_mm)
             # the bore wall is z-aware: a counterbore only meets the bore over its own depth
-            to_bore = rc - pattern.hole_diameter_mm / 2 - p.bore_radius_between(0.0, t)
+            to_bore = rc - pattern.hole_diameter_mm / 2 - params.bore_radius_between(0.0, t)
             if pattern.counterbore_diameter_mm > 0:
-                cb_bore = p.bore_radius_between(t - pattern.counterbore_depth_mm, t)
+                cb_bore = params.bore_radius_between(t - pattern.counterbore_depth_mm, t)
                 to_bore = min(to_bore, rc - pattern.counterbore_diameter_mm / 2 - cb_bore)
             walls = {
                 "cuts into a gap between beams": min((g.distance(Point(hole.x_mm, hole.y_mm)) - radius
                                                       for g in gaps), default=math.inf),
-                "breaks through the outer edge": p.ring_outer_radius_mm - rc - radius,
+                "breaks through the outer edge": params.ring_outer_radius_mm - rc - radius,
                 "breaks into the central bore": to_bore,
             }
             what, wall = min(walls.items(), key=lambda kv: kv[1])

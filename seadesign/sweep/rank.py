@@ -110,7 +110,7 @@ def rank(table: pd.DataFrame, study: Study) -> tuple[pd.DataFrame, Choice]:
 def explain(t: pd.DataFrame, choice: Choice, study: Study) -> str:
     """Why the chosen candidate wins and what the runner-up trades, in words; for an infeasible choice, what
     blocks it, by how much, and what would unblock it."""
-    b = t.loc[choice.index]
+    chosen = t.loc[choice.index]
     objective = study.requirements.objectives[0]
     column = OBJECTIVE_COLUMNS[objective]
 
@@ -118,22 +118,25 @@ def explain(t: pd.DataFrame, choice: Choice, study: Study) -> str:
         return f"{OBJECTIVE_WORDS[objective]} {r[column]:.4g}" if np.isfinite(r[column]) else \
             f"no {OBJECTIVE_WORDS[objective]} (its path stops at {r['large_stop_torque_Nm']:.3g} Nm: {r['large_stop_reason']})"
 
-    facts = (f"small-load k {b['k_Nm_per_rad']:.3g} Nm/rad, working-range tangent "
-             f"{b['working_min_tangent_k_Nm_per_rad']:.3g}-{b['working_max_tangent_k_Nm_per_rad']:.3g} Nm/rad, "
-             f"{b['mass_g']:.3g} g; its path ends at {b['large_stop_torque_Nm']:.3g} Nm, "
-             f"{b['large_stop_rotation_rad']:.3g} rad ({b['large_stop_reason']})")
+    facts = (f"small-load k {chosen['k_Nm_per_rad']:.3g} Nm/rad, working-range tangent "
+             f"{chosen['working_min_tangent_k_Nm_per_rad']:.3g}-"
+             f"{chosen['working_max_tangent_k_Nm_per_rad']:.3g} Nm/rad, "
+             f"{chosen['mass_g']:.3g} g; its path ends at {chosen['large_stop_torque_Nm']:.3g} Nm, "
+             f"{chosen['large_stop_rotation_rad']:.3g} rad ({chosen['large_stop_reason']})")
     if choice.feasible:
-        text = f"{b['candidate']} meets every requirement and has the smallest {value(b)}: {facts}."
+        text = f"{chosen['candidate']} meets every requirement and has the smallest {value(chosen)}: {facts}."
     elif choice.conditional:
-        text = (f"No candidate meets every requirement with each judged. {b['candidate']} meets every requirement "
-                f"that can be judged, with the smallest {value(b)}, but is only conditional: {b['not_judged']}. "
+        text = (f"No candidate meets every requirement with each judged. {chosen['candidate']} meets every requirement "
+                f"that can be judged, with the smallest {value(chosen)}, but is only conditional: "
+                f"{chosen['not_judged']}. "
                 f"It is {facts}.")
     else:
-        text = (f"No candidate meets every requirement: NOT a recommendation. The closest ({int(b['n_failed_constraints'])} "
-                f"missed) is {b['candidate']}, which misses {blocking(b, study)}; {facts}.")
-        if b["not_judged"]:
-            text += f" Not judged: {b['not_judged']}."
-        text += " " + unblock(b, study)
+        text = (f"No candidate meets every requirement: NOT a recommendation. The closest "
+                f"({int(chosen['n_failed_constraints'])} "
+                f"missed) is {chosen['candidate']}, which misses {blocking(chosen, study)}; {facts}.")
+        if chosen["not_judged"]:
+            text += f" Not judged: {chosen['not_judged']}."
+        text += " " + unblock(chosen, study)
     if choice.runner_up is not None:
         r = t.loc[choice.runner_up]
         text += f" Runner-up: {r['candidate']}, {value(r)}" + ("." if not r["failed_constraints"] else
