@@ -15,7 +15,7 @@ from seadesign.explore.encoding import Encoding
 from seadesign.explore.explorer import Explorer, ExplorerSettings
 from seadesign.explore.models import Models
 from seadesign.explore.sensitivity import sobol_indices
-from seadesign.explore.stopping import EvaluationBudget, Progress, first_reason
+from seadesign.explore.stopping import EvaluationBudget, Progress, StalledFront, first_reason
 from seadesign.explore.surrogate import FeasibilityClassifier, Surrogate
 
 AXES = (Axis("thickness_mm", bounds=(6.0, 20.0)), Axis("beam_count", (3, 4, 6, 10)),
@@ -107,3 +107,9 @@ def test_ask_and_tell_stop_on_the_callers_rule():
     assert explorer.stop_reason == "budget spent" and explorer.ask() is None
     assert sum(told[:-1]) < 7 <= sum(told) == problem.evaluations == len(explorer.result().evaluated) < 20
     assert all(n <= 2 for n in told[1:])  # after the initial design, one batch a round
+
+    capped = BNH()
+    explorer = Explorer(capped, ExplorerSettings(budget=8, batch=2, seed=0), rules=(StalledFront(100),))
+    while (X := explorer.ask()) is not None:  # rules without a budget: the settings' budget still caps the run
+        explorer.tell(X, capped.evaluate(X))
+    assert explorer.stop_reason == "budget spent" and capped.evaluations == 8

@@ -190,6 +190,9 @@ class Explorer:
         if not self.rounds:
             return self.state.admit(self._initial_design())
         while True:
+            if self.state.evaluations_left <= 0:  # the settings' budget caps a caller's own rules too
+                self.stop_reason = "budget spent"
+                return None
             self.round_index += 1
             want = min(self.settings.batch, self.state.evaluations_left)
             X = self._propose(want)
@@ -208,7 +211,8 @@ class Explorer:
                 return None
 
     def tell(self, X: np.ndarray, rows: pd.DataFrame | None) -> None:
-        """The problem's rows (`DesignProblem.evaluate`) for the designs X that `ask` gave (None when it gave none)."""
+        """The problem's rows (`DesignProblem.evaluate`) for the designs X that `ask` gave (None when it gave
+        none)."""
         before = self.state.evaluated.copy()
         if len(X):
             self.state.add(X, rows, self.round_index)

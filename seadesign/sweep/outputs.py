@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from seadesign.design.study import Candidate, Study
+from seadesign.design.candidate import Candidate
+from seadesign.design.study import Study
 from seadesign.report import write_plots, write_renders, write_tables
 from seadesign.report.document import write_html, write_markdown
 from seadesign.report.sweep_page import Baseline, sweep_page
