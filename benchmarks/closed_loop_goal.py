@@ -1,5 +1,5 @@
 """The closed-loop goal of one or more corrector bundles, cell by cell, nominal and in the robustness cases:
-the fair comparison of the families (same cases, same baselines, one table).
+the fair comparison of the correctors (same cases, same baselines, one table).
 
 For each case (`goal.goal_cases`: nominal thesis protocol; a gait with a 0.7 s cycle; k x0.7 and x1.4; real-knee
 effects; the large-deflection law swapped), setting and bundle: mean |Hall error| of the corrector and of the best

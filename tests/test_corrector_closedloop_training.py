@@ -268,8 +268,8 @@ def test_the_closed_loop_policy_from_scratch_meets_the_closed_loop_goal_in_every
     for setting in ("hanging", "ground"):
         table, runs[setting] = closed_loop_table([NoCorrection(), HallPI(), FeedForward(k), corrector], spring,
                                                  (setting,))
-        rows[setting] = table.set_index("candidate").loc["family2"]
-    goal = goal_table(runs, "family2")
+        rows[setting] = table.set_index("candidate").loc["closedloop"]
+    goal = goal_table(runs, "closedloop")
     assert len(goal) == 36 and goal.meets_goal.all() and not goal.flagged.any()
     assert goal.gain.min() >= 0.6
     assert rows["hanging"].mean_abs_error_rad < 0.02 and rows["ground"].mean_abs_error_rad < 0.09
