@@ -75,7 +75,7 @@ def test_the_default_study_answer_and_its_handoff(tmp_path):
 
 def _documented_calibration_lines() -> list[str]:
     """The printed lines of the worked calibration in docs/explanation/calibration.md (its block starting "calibration:")."""
-    page = (Path(__file__).resolve().parents[1] / "docs" / "explanation" / "loop.md").read_text()
+    page = (Path(__file__).resolve().parents[1] / "docs" / "explanation" / "calibration.md").read_text()
     block = page.split("```\ncalibration:", 1)[1].split("```", 1)[0]
     return [line.strip() for line in ("calibration:" + block).splitlines() if line.strip()]
 
