@@ -127,6 +127,9 @@ class ContactSummary:
     penetration_m: float
 
 
+NO_CONTACT = ContactSummary(0.0, 0.0, (float("nan"),) * 3, 0.0, 0.0)
+
+
 @dataclass(frozen=True)
 class Multipliers:
     """The augmented Lagrangian's multipliers (Pa), one a (point, facet) pair, kept by the pair's key
@@ -308,7 +311,7 @@ class FrictionlessContact:
         t = self.pressure_Pa(pairs)
         a = t > 0
         if not a.any():
-            return ContactSummary(0.0, 0.0, (float("nan"),) * 3, 0.0, 0.0)
+            return NO_CONTACT
         w = self.surface.weights_m2[pairs.point[a]]
         x = self.surface.points(u, pairs.point[a])
         force = -(w * t[a])[:, None] * self._gradient(u, pairs, a)[:, :6].sum(axis=1)  # on the checked points' faces
@@ -324,6 +327,19 @@ class FrictionlessContact:
         keys = pairs.point * len(self.surface.facets) + pairs.facet
         order = np.argsort(keys)
         self.multipliers = Multipliers(keys[order], self.pressure_Pa(pairs)[order])
+
+    def closing_fraction(self, u0: np.ndarray, u1: np.ndarray) -> float:
+        """How far (0 to 1) from u0 to u1, the gaps linear in between, the first of the pairs pressed at u1 touches
+        (their multipliers taken as zero: contact first carrying pressure); 1 when no pair is pressed at u1."""
+        active = self.active(u1)
+        if not len(active):
+            return 1.0
+        which = (active[:, 0], active[:, 1])
+        g0, g1 = self.pairs(u0, which).gap_m, self.pairs(u1, which).gap_m
+        closing = g1 < g0
+        if not closing.any():
+            return 1.0
+        return float(np.clip(g0[closing] / (g0[closing] - g1[closing]), 0.0, 1.0).min())
 
     def penetration_m(self, u: np.ndarray, assignment: tuple[np.ndarray, np.ndarray] | None = None) -> float:
         """The largest penetration (m) of a point under pressure at u, 0 without one (pairs as in `pairs`)."""

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from seadesign.fea.torque_path import PathPoint, hermite, hermite_inverse
+from seadesign.fea.torque_path import PathEvent, PathPoint, hermite, hermite_inverse
 
 if TYPE_CHECKING:
     from seadesign.fea.rotation_path import PathSettings
@@ -19,7 +19,7 @@ def stop_check(s: PathSettings, prev: PathPoint, point: PathPoint, target_Nm: fl
     so that the one met first is located (the caller cuts the step until it is)."""
     if point.tangent_Nm_per_rad <= 0 or point.torque_Nm <= prev.torque_Nm:
         return "limit_point"
-    if point.min_gap_mm < s.contact_gap_mm:
+    if s.contact is None and point.min_gap_mm < s.contact_gap_mm:
         return "contact"
     if s.allowable_strain is not None and point.peak_tensile_strain > s.allowable_strain:
         return "strain_limit"
@@ -30,12 +30,24 @@ def stop_check(s: PathSettings, prev: PathPoint, point: PathPoint, target_Nm: fl
     return None
 
 
+def touching_gap_mm(s: PathSettings) -> float:
+    """The gap (mm) at which surfaces touch: zero with contact forces, else the gap at which the path stops."""
+    return s.contact_gap_mm if s.contact is None else 0.0
+
+
 def contact_rotation(a: PathPoint, b: PathPoint, s: PathSettings) -> float | None:
-    """Where the gap, linear through a and b, reaches `contact_gap_mm` (rad); None unless both gaps are
+    """Where the gap, linear through a and b, reaches `touching_gap_mm` (rad); None unless both gaps are
     finite and differ."""
     if not (np.isfinite(a.min_gap_mm) and np.isfinite(b.min_gap_mm)) or a.min_gap_mm == b.min_gap_mm:
         return None
-    return a.rotation_rad + (a.min_gap_mm - s.contact_gap_mm) / (a.min_gap_mm - b.min_gap_mm) * (b.rotation_rad - a.rotation_rad)
+    return a.rotation_rad + (a.min_gap_mm - touching_gap_mm(s)) / (a.min_gap_mm - b.min_gap_mm) * (b.rotation_rad - a.rotation_rad)
+
+
+def contact_event(a: PathPoint, b: PathPoint, fraction: float) -> PathEvent:
+    """Contact first carrying pressure `fraction` of the way from a to b (see `FrictionlessContact.closing_fraction`):
+    its rotation, the torque there on the curve, and where the pressure peaks at b."""
+    theta = a.rotation_rad + fraction * (b.rotation_rad - a.rotation_rad)
+    return PathEvent("contact", theta, float(hermite(a, b, fraction)), b.contact.peak_at_mm)
 
 
 def bracketing_step(contact_rad: float, theta: float, s: PathSettings) -> float:

@@ -15,9 +15,14 @@ The path stops, and says why (`STOP_REASONS` of `design.spring`):
 - bifurcation: the free nodes' tangent stiffness lost positive definiteness (an eigenvalue crossed
   zero, counted by its inertia: a buckling mode); both are located by bisection to `locate_tol_rad`
   (contact to `contact_locate_tol_rad`, then where the gap interpolates to the tolerance);
-- contact: two facing surfaces (outward normals opposed by more than 120 degrees) come closer
-  than `contact_gap_mm` (the notch beside a beam's root closing, a beam reaching its neighbour);
-  the model has no contact forces, so the path ends there, interpolated to the tolerance;
+- contact, without `PathSettings.contact`: two facing surfaces (outward normals opposed by more than
+  120 degrees) come closer than `contact_gap_mm` (the notch beside a beam's root closing, a beam
+  reaching its neighbour); without contact forces the path ends there, interpolated to the tolerance.
+  With `PathSettings.contact`, frictionless self-contact (`fea.contact`, an augmented Lagrangian)
+  carries the closed gap and the path goes on: first contact is an event (`TorquePath.events`, where
+  the first pressed pair's gap closes), each point records the contact's area, peak pressure, moment
+  and penetration, and an increment whose penetration the multiplier updates cannot bring within
+  the tolerance is cut back like one that does not converge;
 - strain_limit: the peak tensile principal engineering strain passed the allowable strain;
 - rotation_limit: the rotation reached `max_rotation_rad` below the target torque;
 - unconverged: the increment fell below `min_step_rad` without convergence (never a capacity).
@@ -33,14 +38,15 @@ import numpy as np
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import NotPositiveDefinite, SolverError
+from seadesign.fea.contact import NO_CONTACT, ContactSettings, ContactSurface, FrictionlessContact, Multipliers
 from seadesign.fea.facing import FacingSurfaces
 from seadesign.fea.elements import element_mesh
 from seadesign.fea.equilibrium import Equilibrium
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.hub_rotation import HubRotation, moment_z
-from seadesign.fea.newton import NewtonSettings, newton
-from seadesign.fea.path_events import bracketing_step, contact_rotation, stop_check, stop_point
-from seadesign.fea.torque_path import PathPoint, TorquePath
+from seadesign.fea.newton import NewtonResult, NewtonSettings, newton, newton_augmented
+from seadesign.fea.path_events import bracketing_step, contact_event, contact_rotation, stop_check, stop_point
+from seadesign.fea.torque_path import PathEvent, PathPoint, TorquePath
 from seadesign.fea.torsion import MM, surface_nodes
 from seadesign.mesh.tetmesh import TetMesh
 
@@ -60,6 +66,8 @@ class PathSettings:
     contact_gap_mm: float = 0.1  # a quarter of an extrusion width: printed faces are not truer than that
     contact_search_mm: float = 0.5  # below the thinnest feature: faces further apart are never checked
     allowable_strain: float | None = None  # engineering strain; None: no strain stop
+    contact: ContactSettings | None = None  # frictionless self-contact through which the path goes on; None: the
+    # path stops where facing surfaces come within `contact_gap_mm`
 
 
 @dataclass
@@ -84,7 +92,12 @@ def path_problem(mesh: TetMesh, law: Hyperelastic, settings: PathSettings, order
     emesh = element_mesh(mesh.points_mm * MM, mesh.tets, order)
     hub = HubRotation.on(mesh, emesh, hub_boundaries, ring_boundaries)
     held_z = None if axially_held_faces is None else surface_nodes(emesh, axially_held_faces)
-    system = Equilibrium.of(Solid.of(emesh, law, formulation), hub.prescribed, hub.hub, settings.force_rtol, held_z)
+    contact = None
+    if settings.contact is not None:
+        contact = FrictionlessContact.of(ContactSurface.of(emesh, mesh.boundary_faces, hub.prescribed),
+                                         law.shear_modulus_Pa, settings.contact)
+    system = Equilibrium.of(Solid.of(emesh, law, formulation), hub.prescribed, hub.hub, settings.force_rtol, held_z,
+                            contact)
     return PathProblem(hub, system, FacingSurfaces.of(emesh.nodes_m, mesh.boundary_faces, settings.contact_search_mm),
                        settings)
 
@@ -93,18 +106,20 @@ def _state(p: PathProblem, u: np.ndarray, f: np.ndarray, theta: float, iteration
            norms: list[float]) -> tuple[PathPoint, np.ndarray]:
     """The converged point at u (internal forces f) and the path's direction du/dtheta there, from the
     tangent factored at u (NotPositiveDefinite: unstable); the next increment's Newton starts with it."""
+    p.system.stability(u)
     fac = p.system.factor(u)
     v = np.zeros_like(u)
     v[p.drive.hub] = p.drive.velocity(theta)
-    v[p.system.free] = -fac.solve(p.system.residual(p.solid.tangent_product(u, v))).reshape(-1, 3)
-    df = p.solid.tangent_product(u, v, rows=p.drive.hub)  # dT/dtheta needs the hub's rows only
+    v[p.system.free] = -fac.solve(p.system.residual(p.system.tangent_product(u, v))).reshape(-1, 3)
+    df = p.system.tangent_product(u, v, rows=p.drive.hub)  # dT/dtheta needs the hub's rows only
     xd = p.solid.mesh.nodes_m[p.drive.hub] + u[p.drive.hub]
     dT = moment_z(v[p.drive.hub], f[p.drive.hub]) + moment_z(xd, df[p.drive.hub])
     strain = p.solid.element_strain_stress(u)
     i, j, c = (int(np.argmax(x)) for x in (strain.tensile_strain, strain.von_mises_Pa, strain.compressive_strain))
     gap, gap_at = p.surfaces.min_gap_mm(u)
+    contact = NO_CONTACT if p.system.contact is None else p.system.contact.summary(u)
     point = PathPoint(theta, p.drive.torque(u, f), dT, float(strain.tensile_strain[i]), gap, iterations, tuple(norms),
-                      i, float(strain.compressive_strain[c]), c, float(strain.von_mises_Pa[j]), j, gap_at)
+                      i, float(strain.compressive_strain[c]), c, float(strain.von_mises_Pa[j]), j, gap_at, contact)
     return point, v
 
 
@@ -134,13 +149,15 @@ def rotation_path(
         first, v = _state(p, u, np.zeros_like(u), 0.0, 0, [0.0])
         points, step, cuts, reason, previous = [first], settings.first_step_rad, 0, None, None
         snapshot, probe = None, None  # probe: the last attempt rejected for contact since the last point
+        events: list[PathEvent] = []
+        held = None if p.system.contact is None else p.system.contact.multipliers  # the last point's multipliers
         while reason is None:
             last = points[-1]
             step = min(step, settings.max_step_rad, settings.max_rotation_rad - last.rotation_rad)
             theta = last.rotation_rad + step
             guess = _predict(p, u, v, step, previous, last.rotation_rad)
             guess[p.drive.hub] = p.drive.displacement(theta)
-            solved = newton(p.system, guess, settings.newton)
+            solved = _solve(p, guess, held)
             trial, forces, norms, status = solved.u, solved.forces, solved.residual_norms, solved.status
             event = None
             if status == "converged":
@@ -161,9 +178,12 @@ def rotation_path(
                     contact = next((c for c in estimates if c is not None and last.rotation_rad < c < theta), None)
                     probe = point
                 step = step * 0.5 if contact is None else bracketing_step(contact, last.rotation_rad, settings)
-                if status == "failed" and step < settings.min_step_rad:
+                if status in ("failed", "penetrating") and step < settings.min_step_rad:
                     reason = "unconverged"
             else:
+                if p.system.contact is not None and not events and point.contact.area_m2 > 0:
+                    events.append(contact_event(last, point, p.system.contact.closing_fraction(u, trial)))
+                held = None if p.system.contact is None else p.system.contact.multipliers
                 points.append(point)
                 if snapshot is None and snapshot_torque_Nm is not None and point.torque_Nm >= snapshot_torque_Nm:
                     snapshot = (len(points) - 1, trial)
@@ -171,7 +191,7 @@ def rotation_path(
                 u, v, reason = trial, v_new, event
                 if len(norms) <= 8:
                     step *= 1.5
-                contact = contact_rotation(last, point, settings)  # a closing gap: bracket where it closes
+                contact = None if events else contact_rotation(last, point, settings)  # a closing gap: bracket it
                 if contact is not None and contact > point.rotation_rad:
                     step = min(step, bracketing_step(contact, point.rotation_rad, settings))
     finally:
@@ -179,7 +199,16 @@ def rotation_path(
     stop_theta, stop_torque = stop_point(points, reason, target_torque_Nm, settings.contact_gap_mm)
     index, shot = snapshot or (len(points) - 1, u)
     return TorquePath(tuple(points), reason, stop_theta, stop_torque, u, p.solid.mesh, cuts, p.system.factorizations,
-                      time.perf_counter() - t0, index, shot)
+                      time.perf_counter() - t0, index, shot, tuple(events))
+
+
+def _solve(p: PathProblem, guess: np.ndarray, held: Multipliers | None) -> NewtonResult:
+    """Newton from the guess; with contact, the augmented Lagrangian from the last converged point's
+    multipliers `held` (every attempt, a cut-back's too, starts from them)."""
+    if p.system.contact is None:
+        return newton(p.system, guess, p.settings.newton)
+    p.system.contact.multipliers = held
+    return newton_augmented(p.system, guess, p.settings.newton)
 
 
 def _predict(p: PathProblem, u: np.ndarray, v: np.ndarray, step: float,

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from seadesign.fea.contact import NO_CONTACT, ContactSummary
 from seadesign.fea.elements import ElementMesh
 
 
@@ -27,6 +28,18 @@ class PathPoint:
     peak_von_mises_Pa: float = 0.0  # largest Cauchy von Mises stress at the quadrature points
     peak_von_mises_element: int = -1
     min_gap_at_mm: tuple[float, float, float] = (float("nan"),) * 3  # where the smallest gap is (at rest)
+    contact: ContactSummary = NO_CONTACT  # the contact's pressure, area and moment (a path through contact)
+
+
+@dataclass(frozen=True)
+class PathEvent:
+    """Something the path passes without stopping: its kind ("contact": facing surfaces first carry pressure),
+    rotation (rad), torque (Nm) and where (mm, the part at rest)."""
+
+    kind: str
+    rotation_rad: float
+    torque_Nm: float
+    at_mm: tuple[float, float, float]
 
 
 @dataclass(frozen=True)
@@ -44,6 +57,7 @@ class TorquePath:
     time_s: float = 0.0
     snapshot_index: int = -1  # the point whose displacement is `snapshot_displacement_m` (see rotation_path)
     snapshot_displacement_m: np.ndarray | None = field(default=None, repr=False)
+    events: tuple[PathEvent, ...] = ()
 
     def torque_at(self, rotation_rad: float) -> float | None:
         """Torque (Nm) at `rotation_rad` on the cubic Hermite curve through the points, None past the last."""

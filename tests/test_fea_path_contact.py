@@ -1,0 +1,81 @@
+"""The rotation path through frictionless self-contact, on the default study's 3 beams x 8 mm on a 4x coarser
+one-layer mesh (4.2k tetrahedra): its notch closes near 0.32 rad. References: the path without contact forces
+(the same equilibria before contact), the work of the hub torque (frictionless contact stores no energy of its
+own) and the penetration tolerance."""
+
+from __future__ import annotations
+
+import pytest
+
+from seadesign.fea.contact import ContactSettings
+from seadesign.fea.finite_strain import Solid
+from seadesign.fea.rotation_path import PathSettings, rotation_path
+
+END_RAD = 0.42
+
+
+@pytest.fixture(scope="module")
+def candidate(tmp_path_factory):
+    from seadesign.design.study import load_study
+    from seadesign.run.cache import Cache
+    from seadesign.sweep.stages import tetrahedralize
+
+    study = load_study()
+    checked, part = study.check(study.candidate(beam_count=3, beam_thickness_mm=8.0))
+    mesh = tetrahedralize(study, checked, part, Cache(tmp_path_factory.mktemp("cache")), coarsening=4.0, layers=1)
+    return mesh, study.material.law
+
+
+def _path(candidate, **settings):
+    mesh, law = candidate
+    contact = settings.pop("contact", ContactSettings())
+    return rotation_path(mesh, law, 100.0, PathSettings(max_rotation_rad=END_RAD, contact=contact, **settings))
+
+
+@pytest.fixture(scope="module")
+def through(candidate):
+    return _path(candidate)
+
+
+def _work(path) -> float:
+    """The hub torque's work (J): the integral of the cubic Hermite curve through the points (exact for it)."""
+    return sum((b.rotation_rad - a.rotation_rad) / 2 * (a.torque_Nm + b.torque_Nm)
+               + (b.rotation_rad - a.rotation_rad) ** 2 / 12 * (a.tangent_Nm_per_rad - b.tangent_Nm_per_rad)
+               for a, b in zip(path.points, path.points[1:]))
+
+
+def test_the_path_goes_on_through_contact(through):
+    assert through.stop_reason == "rotation_limit" and through.stop_rotation_rad == END_RAD
+    (event,) = through.events
+    assert event.kind == "contact" and 0.31 < event.rotation_rad < 0.32  # measured 0.3179 rad (the step landed at 0.32)
+    last = through.points[-1].contact
+    assert last.area_m2 > 1e-6 and last.peak_pressure_Pa > 1e6 and last.moment_Nm > 0.05  # measured 1.9 mm^2, 13 MPa, 0.24 Nm
+    tolerance_m = ContactSettings().penetration_tol_mm * 1e-3
+    assert all(p.contact.penetration_m <= tolerance_m for p in through.points)
+    before = [p for p in through.points if p.rotation_rad < event.rotation_rad]
+    assert all(p.contact.area_m2 == 0 for p in before) and through.points[len(before)].contact.area_m2 > 0
+
+
+def test_frictionless_contact_stores_no_energy(candidate, through):
+    # the hub's work equals the strain energy at the end: measured 1.3e-5 of it (the rest is the contact force times
+    # the penetration the tolerance allows, and the curve's interpolation); without contact to the same rotation the
+    # path's own balance is 3e-7
+    mesh, law = candidate
+    energy = Solid.of(through.emesh, law).energy(through.displacement_m)
+    assert abs(_work(through) - energy) < 4e-5 * energy
+
+
+def test_before_contact_the_path_is_the_one_without_contact_forces(candidate, through):
+    # the path that stops at contact solves the same equilibria until then: its points lie on the through-contact
+    # curve to the Hermite interpolation's error (measured 1.8e-5)
+    stop = _path(candidate, contact=None)
+    assert stop.stop_reason == "contact"
+    for point in stop.points[1:]:
+        assert through.torque_at(point.rotation_rad) == pytest.approx(point.torque_Nm, rel=1e-4)
+
+
+@pytest.mark.slow
+def test_the_torque_does_not_depend_on_the_penalty(candidate, through):
+    # a ten times tighter penetration tolerance moves the end torque by 3e-6 (measured)
+    tight = _path(candidate, contact=ContactSettings(penetration_tol_mm=0.0005))
+    assert tight.points[-1].torque_Nm == pytest.approx(through.points[-1].torque_Nm, rel=1e-4)
