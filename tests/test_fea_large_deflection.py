@@ -5,6 +5,7 @@ has an exact value. The repeating loads are read against a cyclic limit of 0.3, 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -14,7 +15,8 @@ from seadesign.design.materials import StrainLimits
 from seadesign.fea.large_deflection import large_deflection
 from seadesign.fea.results import columns
 from seadesign.fea.path_events import stop_point
-from seadesign.fea.torque_path import PathPoint, TorquePath
+from seadesign.fea.contact import ContactSummary
+from seadesign.fea.torque_path import PathEvent, PathPoint, TorquePath
 
 A, B = 15.0, 0.8  # Nm, rad: initial stiffness A / B = 18.75 Nm/rad
 LIMITS = StrainLimits(cyclic=0.3, single=0.433)
@@ -68,6 +70,23 @@ def test_a_load_past_the_stop_is_not_extrapolated_unless_contact_is_an_end_stop(
     assert stop.stall.tensile_strain == pytest.approx(0.25) and math.isnan(stop.stall.tangent_k_Nm_per_rad)
     limit = large_deflection(_path(0.5, "limit_point"), 2.0, 11.7, 14.0, LIMITS, contact_is_end_stop=True)
     assert not limit.stall.survives and math.isnan(limit.stall.rotation_rad)  # a torque maximum is no end stop
+
+
+def test_through_contact_the_event_names_first_contact_and_the_loads_their_share():
+    # the same curve, gone on through contact from 0.3 rad: the pairs' moment grows as 2 (theta - 0.3) Nm, the
+    # pressure as 10 (theta - 0.3) MPa; contact is read from the event, not the stop
+    base = _path(1.5, "target_reached")
+    points = tuple(replace(p, contact=ContactSummary(1e-6, 1e7 * (p.rotation_rad - 0.3), (1.0, 2.0, 3.0),
+                                                     2 * (p.rotation_rad - 0.3), 1e-6))
+                   if p.rotation_rad > 0.3 else p for p in base.points)
+    event = PathEvent("contact", 0.3, A * math.tanh(0.3 / B), (1.0, 2.0, 3.0))
+    ld = large_deflection(replace(base, points=points, events=(event,)), 2.0, 11.7, 14.0, LIMITS)
+    assert ld.stop_reason == "target_reached" and ld.contact_rotation_rad == 0.3
+    assert ld.contact_torque_Nm == event.torque_Nm and (ld.contact_at.x_mm, ld.contact_at.z_mm) == (1.0, 3.0)
+    assert ld.peak_contact_pressure_MPa == pytest.approx(12.0)
+    assert ld.standing.contact_share == 0.0  # 2 Nm: before contact
+    for point, torque in ((ld.stall, 11.7), (ld.impact, 14.0)):  # points 0.0375 rad apart: linear interpolation
+        assert point.contact_share == pytest.approx(2 * (_theta(torque) - 0.3) / torque, rel=1e-3)
 
 
 def test_columns_keep_words_flags_and_curves():

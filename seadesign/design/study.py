@@ -58,6 +58,7 @@ class Ranking:
     impact_speed_m_per_s: float  # foot speed at touchdown
     knee_inertia_kg_m2: float  # inertia of the link behind the spring, about the knee
     contact_is_end_stop: bool = False  # contact closing a gap may carry torque past it (else: contact ends the travel)
+    self_contact: bool = False  # the path goes on through frictionless self-contact (else: it ends at first contact)
 
 
 @dataclass(frozen=True)
@@ -331,7 +332,11 @@ def _ranking(top: Table) -> tuple[Ranking, Requirements]:
         impact_speed_m_per_s=rk.number("impact_speed_m_per_s", gt=0),
         knee_inertia_kg_m2=rk.number("knee_inertia_kg_m2", gt=0),
         contact_is_end_stop=rk.boolean("contact_is_end_stop", False),
+        self_contact=rk.boolean("self_contact", False),
     )
+    if ranking.self_contact and ranking.contact_is_end_stop:
+        raise rk.error(rk.key("contact_is_end_stop"), "and self_contact = true exclude each other: with self-contact the "
+                       "path goes on through contact, so contact ends no travel; remove contact_is_end_stop")
     refuse_moved_keys(rk)
     rk.done()
     return ranking, read_requirements(top.table("requirements", optional=True))

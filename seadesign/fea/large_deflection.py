@@ -24,7 +24,7 @@ import numpy as np
 
 from seadesign.design.materials import StrainLimits
 from seadesign.fea.results import nested, unscaled
-from seadesign.fea.torque_path import TorquePath
+from seadesign.fea.torque_path import PathEvent, TorquePath
 
 
 @dataclass(frozen=True)
@@ -53,6 +53,7 @@ class LoadPoint:
     tensile_at: PeakLocation = nested()  # where it is (at the nearest path point)
     compressive_strain: float = unscaled()  # largest compressive principal engineering strain (1 - stretch)
     compressive_at: PeakLocation = nested()
+    contact_share: float = unscaled()  # the pair forces' moment about the axis over the torque (0: no contact)
     strain_limit: float = unscaled()  # the allowable tensile strain of this load's class (NaN: not sourced)
     strain_margin: float = unscaled()  # strain limit / tensile strain (NaN without a limit)
     survives: bool = unscaled()  # carried (reached or at an end stop) with the tensile strain within a sourced limit
@@ -69,9 +70,11 @@ class LargeDeflection:
     stop_reason: str = unscaled()  # see fea.rotation_path
     stop_rotation_rad: float = unscaled()
     stop_torque_Nm: float = unscaled()
-    contact_rotation_rad: float = unscaled()  # NaN: no contact on the path
+    contact_rotation_rad: float = unscaled()  # first contact (the path's stop, or its event through contact); NaN: none
     contact_torque_Nm: float = unscaled()
-    contact_at: PeakLocation = nested()  # the closing pair's midpoint at rest (NaN: no contact)
+    contact_at: PeakLocation = nested()  # the closing pair's midpoint at rest, or through contact where the first
+    # contact's pressure peaks (NaN: no contact)
+    peak_contact_pressure_MPa: float = unscaled()  # the largest contact pressure on the path (0: none carried)
     cyclic_strain_limit: float = unscaled()  # NaN: the material has no sourced cyclic strain limit
     single_strain_limit: float = unscaled()  # elongation at yield / safety factor (NaN: not sourced)
     cyclic_limit_rotation_rad: float = unscaled()  # where the tensile strain passes the cyclic limit (NaN: never)
@@ -131,11 +134,12 @@ def _load_point(path: TorquePath, theta: np.ndarray, torque_Nm: float, limit: fl
     else:
         rotation = math.nan
     carried = math.isfinite(rotation)
-    tensile = compressive = math.nan
+    tensile = compressive = share = math.nan
     tensile_at = compressive_at = NOWHERE
     if carried:
         tensile = float(np.interp(rotation, theta, [p.peak_tensile_strain for p in path.points]))
         compressive = float(np.interp(rotation, theta, [p.peak_compressive_strain for p in path.points]))
+        share = float(np.interp(rotation, theta, [p.contact.moment_Nm for p in path.points])) / torque_Nm
         near = path.points[int(np.argmin(np.abs(theta - rotation)))]
         tensile_at = _location(path, near.peak_tensile_element)
         compressive_at = _location(path, near.peak_compressive_element)
@@ -149,6 +153,7 @@ def _load_point(path: TorquePath, theta: np.ndarray, torque_Nm: float, limit: fl
         tensile_at=tensile_at,
         compressive_strain=compressive,
         compressive_at=compressive_at,
+        contact_share=share,
         strain_limit=limit,
         strain_margin=limit / tensile if math.isfinite(limit) and tensile > 0 else math.nan,
         survives=bool(carried and tensile <= limit),  # False where the limit is not sourced (NaN)
@@ -164,7 +169,9 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
     theta = np.array([p.rotation_rad for p in pts])
     torque = np.array([p.torque_Nm for p in pts])
     tensile = np.array([p.peak_tensile_strain for p in pts])
-    contact = path.stop_reason == "contact"
+    first_contact = next((e for e in path.events if e.kind == "contact"), None)
+    if first_contact is None and path.stop_reason == "contact":
+        first_contact = PathEvent("contact", path.stop_rotation_rad, path.stop_torque_Nm, pts[-1].min_gap_at_mm)
 
     def limit_torque(rotation: float) -> float:
         return float(np.interp(rotation, theta, torque)) if math.isfinite(rotation) else math.nan
@@ -181,9 +188,10 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
         stop_reason=path.stop_reason,
         stop_rotation_rad=path.stop_rotation_rad,
         stop_torque_Nm=path.stop_torque_Nm,
-        contact_rotation_rad=path.stop_rotation_rad if contact else math.nan,
-        contact_torque_Nm=path.stop_torque_Nm if contact else math.nan,
-        contact_at=PeakLocation(*pts[-1].min_gap_at_mm) if contact else NOWHERE,
+        contact_rotation_rad=first_contact.rotation_rad if first_contact else math.nan,
+        contact_torque_Nm=first_contact.torque_Nm if first_contact else math.nan,
+        contact_at=PeakLocation(*first_contact.at_mm) if first_contact else NOWHERE,
+        peak_contact_pressure_MPa=max(p.contact.peak_pressure_Pa for p in pts) * 1e-6,
         cyclic_strain_limit=cyclic,
         single_strain_limit=single,
         cyclic_limit_rotation_rad=cyclic_theta,

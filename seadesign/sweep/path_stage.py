@@ -16,6 +16,7 @@ import numpy as np
 
 from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
+from seadesign.fea.contact import ContactSettings
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.large_deflection import LargeDeflection, large_deflection
 from seadesign.fea.rotation_path import PathSettings, rotation_path
@@ -41,12 +42,17 @@ class PathResponse:
     snapshot_torque_Nm: float
 
 
+def path_settings(study: Study) -> PathSettings:
+    """The path's settings: with the study's `[ranking] self_contact`, through frictionless self-contact."""
+    return PathSettings(contact=ContactSettings() if study.ranking.self_contact else None)
+
+
 def path_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
     """Inputs of the path: the mesh, the law, the path's mesh and settings, the torques, the strain limits,
     the end-stop rule and the code of this module with everything it imports."""
     lc = study.load_cases
     return digest("path", mesh_key(study, candidate), candidate.material.law, settings.path_layers,
-                  settings.path_formulation, PathSettings(), study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm,
+                  settings.path_formulation, path_settings(study), study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm,
                   lc.impact_torque_Nm, candidate.material.strain_limits(study.ranking.safety_factor),
                   study.ranking.contact_is_end_stop, code_fingerprint(__name__), package_versions())
 
@@ -62,7 +68,7 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     mesh = tetrahedralize(study, candidate, part(), cache, layers=settings.path_layers)
     progress("path")
     lc, m = study.load_cases, candidate.material
-    path = rotation_path(mesh, m.law, lc.impact_torque_Nm, PathSettings(), order=settings.element_order,
+    path = rotation_path(mesh, m.law, lc.impact_torque_Nm, path_settings(study), order=settings.element_order,
                          formulation=settings.path_formulation, snapshot_torque_Nm=lc.stall_torque_Nm)
     result = large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
                               m.strain_limits(study.ranking.safety_factor), study.ranking.contact_is_end_stop)
