@@ -18,7 +18,9 @@ def test_torque_curve_legend_names_the_choice_then_the_lightest(tmp_path, monkey
                       "large_curve_torque_Nm": [[0.0, 20.0] for _ in range(n)], "large_stop_reason": "target_reached",
                       "large_stop_rotation_rad": [0.1 + 0.01 * i for i in range(n)], "large_stop_torque_Nm": 20.0,
                       **{f"large_{kind}_limit_{x}": np.nan for kind in ("cyclic", "single")
-                         for x in ("rotation_rad", "torque_Nm")}})
+                         for x in ("rotation_rad", "torque_Nm")},
+                      "large_contact_rotation_rad": [0.05 if i == chosen else np.nan for i in range(n)],
+                      "large_contact_torque_Nm": 10.0})
     figures = []
     monkeypatch.setattr(plots.plt, "close", figures.append)
     plots.fig_curves(t, chosen, 10.0, 20.0, tmp_path / "curves.png")
@@ -28,6 +30,8 @@ def test_torque_curve_legend_names_the_choice_then_the_lightest(tmp_path, monkey
     assert names == [f"design {chosen}", *lightest]
     assert legend.get_title().get_text().startswith(f"{n - plots.LEGEND_CURVES} more")
     assert (tmp_path / "curves.png").stat().st_size > 0
+    crosses = [line for line in figures[0].axes[0].get_lines() if line.get_marker() == "x"]
+    assert [(tuple(c.get_xdata()), tuple(c.get_ydata())) for c in crosses] == [((0.05,), (10.0,))]  # first contact
 
 
 def test_parallel_coordinates_draw_a_categorical_axis_as_its_categories(tmp_path, monkeypatch):

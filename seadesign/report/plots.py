@@ -115,7 +115,7 @@ def fig_pareto(t: pd.DataFrame, chosen: int | None, path: Path) -> Path:
 def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: float, path: Path) -> Path:
     """Torque-rotation curves of the large-deflection paths: the Pareto candidates (the ranked pool when it
     could not be scored) in colour, the other solved ones in grey; each curve's stop marked by its reason
-    (x: contact), where the tensile strain passes the cyclic (o) and the single-event limit (s), and the load
+    (x: contact), first contact where the path goes on through it (x), where the tensile strain passes the cyclic (o) and the single-event limit (s), and the load
     torques. The legend names at
     most LEGEND_CURVES of the coloured curves: the chosen one, then the lightest."""
     fig, ax = plt.subplots(figsize=(7, 6.2))
@@ -124,7 +124,7 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
     shown = solved[pareto] if pareto.any() else solved[solved["rank"].notna()]
     for _, r in solved.drop(index=shown.index).iterrows():
         ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color="0.8", lw=0.8)
-    markers = {"contact": "x", "limit_point": "^", "bifurcation": "v", "target_reached": "|"}
+    markers = {"contact": "x", "limit_point": "^", "bifurcation": "v", "target_reached": "|"}  # where it ends
     shown = shown.assign(_chosen=shown.index == chosen).sort_values(["_chosen", "mass_g"], ascending=[False, True],
                                                                     kind="stable")
     for i, (_, r) in enumerate(shown.iterrows()):
@@ -135,6 +135,8 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
                 zorder=3 if r["_chosen"] else 2)
         ax.plot(r["large_stop_rotation_rad"], r["large_stop_torque_Nm"], markers.get(r["large_stop_reason"], "s"),
                 color=color, ms=9, mew=2)
+        if r["large_stop_reason"] != "contact" and np.isfinite(r["large_contact_rotation_rad"]):  # through contact
+            ax.plot(r["large_contact_rotation_rad"], r["large_contact_torque_Nm"], "x", color=color, ms=9, mew=2)
         for kind, marker in (("cyclic", "o"), ("single", "s")):
             if np.isfinite(r[f"large_{kind}_limit_rotation_rad"]):
                 ax.plot(r[f"large_{kind}_limit_rotation_rad"], r[f"large_{kind}_limit_torque_Nm"], marker, mfc="none",
