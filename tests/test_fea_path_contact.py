@@ -5,6 +5,9 @@ own) and the penetration tolerance."""
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 
 from seadesign.fea.contact import ContactSettings
@@ -79,3 +82,13 @@ def test_the_torque_does_not_depend_on_the_penalty(candidate, through):
     # a ten times tighter penetration tolerance moves the end torque by 3e-6 (measured)
     tight = _path(candidate, contact=ContactSettings(penetration_tol_mm=0.0005))
     assert tight.points[-1].torque_Nm == pytest.approx(through.points[-1].torque_Nm, rel=1e-4)
+
+
+@pytest.mark.slow
+def test_contact_that_cannot_be_resolved_ends_the_path_unconverged_saying_where(candidate):
+    # one multiplier update against a tolerance of a picometre: no increment into contact is accepted
+    path = _path(candidate, contact=ContactSettings(penetration_tol_mm=1e-9, max_augmentations=1), min_step_rad=0.005)
+    assert path.stop_reason == "unconverged" and all(p.contact.area_m2 == 0 for p in path.points)
+    event = path.events[-1]
+    assert event.kind == "unresolved_penetration" and event.rotation_rad > path.stop_rotation_rad
+    assert math.isnan(event.torque_Nm) and np.isfinite(event.at_mm).all()

@@ -22,7 +22,8 @@ The path stops, and says why (`STOP_REASONS` of `design.spring`):
   carries the closed gap and the path goes on: first contact is an event (`TorquePath.events`, where
   the first pressed pair's gap closes), each point records the contact's area, peak pressure, moment
   and penetration, and an increment whose penetration the multiplier updates cannot bring within
-  the tolerance is cut back like one that does not converge;
+  the tolerance is cut back like one that does not converge (below `min_step_rad` the path ends
+  unconverged, and an "unresolved_penetration" event says where);
 - strain_limit: the peak tensile principal engineering strain passed the allowable strain;
 - rotation_limit: the rotation reached `max_rotation_rad` below the target torque;
 - unconverged: the increment fell below `min_step_rad` without convergence (never a capacity).
@@ -180,6 +181,9 @@ def rotation_path(
                 step = step * 0.5 if contact is None else bracketing_step(contact, last.rotation_rad, settings)
                 if status in ("failed", "penetrating") and step < settings.min_step_rad:
                     reason = "unconverged"
+                    if status == "penetrating":  # where: the rotation tried, where the contact presses hardest
+                        events.append(PathEvent("unresolved_penetration", theta, float("nan"),
+                                                p.system.contact.summary(trial).peak_at_mm))
             else:
                 if p.system.contact is not None and not events and point.contact.area_m2 > 0:
                     events.append(contact_event(last, point, p.system.contact.closing_fraction(u, trial)))

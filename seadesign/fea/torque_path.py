@@ -33,8 +33,9 @@ class PathPoint:
 
 @dataclass(frozen=True)
 class PathEvent:
-    """Something the path passes without stopping: its kind ("contact": facing surfaces first carry pressure),
-    rotation (rad), torque (Nm) and where (mm, the part at rest)."""
+    """Something on the path: its kind ("contact": facing surfaces first carry pressure; "unresolved_penetration":
+    the multiplier updates could not bring the penetration within the tolerance, so the path ended unconverged,
+    torque NaN), rotation (rad), torque (Nm) and where (mm, the part at rest)."""
 
     kind: str
     rotation_rad: float
