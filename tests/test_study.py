@@ -29,7 +29,7 @@ def test_self_contact_sets_the_path_through_contact(tmp_path):
     from seadesign.sweep.path_stage import path_settings
 
     assert path_settings(load_study()).contact is None
-    on = load_study(_variant(tmp_path, r"^contact_is_end_stop = false", "self_contact = true"))
+    on = load_study(_variant(tmp_path, r"^self_contact = false", "self_contact = true"))
     assert on.ranking.self_contact and path_settings(on).contact == ContactSettings()
 
 
@@ -62,9 +62,9 @@ def _variant(tmp_path: Path, old: str, new: str) -> Path:
         (r"^beam_thickness_mm = \[4.0, 6.0, 8.0\]", "beam_thickness_mm = [4.0, 12.0]",
          "design_space.beam_thickness_mm value 12 mm needs geometry.arc_radius_mm > 6 mm"),
         (r"^safety_factor = 1.5", "safety_factor = 0.5", "ranking.safety_factor must be >= 1"),
-        (r"^contact_is_end_stop = false", "contact_is_end_stop = true\nself_contact = true",
+        (r"^contact_is_end_stop = false(.*)\nself_contact = false", r"contact_is_end_stop = true\1\nself_contact = true",
          "ranking.contact_is_end_stop and self_contact = true exclude each other"),
-        (r"^contact_is_end_stop = false", "self_contact = 1", "ranking.self_contact must be true or false"),
+        (r"^self_contact = false", "self_contact = 1", "ranking.self_contact must be true or false"),
     ],
 )
 def test_bad_study_is_refused_naming_the_key(tmp_path, old, new, message):
