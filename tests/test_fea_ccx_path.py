@@ -112,3 +112,43 @@ def test_calculix_nlgeom_agrees_on_the_default_mesh(tmp_path, ccx):
     path = rotation_path(mesh, study.material.law, study.load_cases.stall_torque_Nm, PathSettings(max_rotation_rad=0.1))
     assert path.stop_reason == "rotation_limit"
     assert _ccx_difference(tmp_path, mesh, study.material.law, path).max() < RTOL
+
+
+def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float, friction: float = 0.0):
+    """Our path through self-contact on a default-study candidate (4x coarser one-layer mesh) to `end_rad`, and
+    CalculiX's on the same mesh with a face-to-face penalty contact pair (ten times our penalty) between the faces
+    within 1.5 mm of where our contact touches at the end; CalculiX's torques at our points."""
+    from seadesign.design.study import load_study
+    from seadesign.fea.ccx_contact import pair_around
+    from seadesign.fea.contact import ContactSettings
+    from seadesign.fea.rotation_path import path_problem
+    from seadesign.run.cache import Cache
+    from seadesign.sweep.stages import tetrahedralize
+
+    study = load_study()
+    checked, part = study.check(study.candidate(beam_count=beams, beam_thickness_mm=thickness_mm))
+    mesh = tetrahedralize(study, checked, part, Cache(tmp_path / "cache"), coarsening=4.0, layers=1)
+    law, settings = study.material.law, PathSettings(max_rotation_rad=end_rad, contact=ContactSettings())
+    path = rotation_path(mesh, law, study.load_cases.impact_torque_Nm, settings)
+    contact = path_problem(mesh, law, settings).system.contact
+    deck = pair_around(contact, path.displacement_m, 1.5, 10 * contact.penalty_Pa_per_m, friction)
+    theta = [p.rotation_rad for p in path.points[1:]]
+    emesh, hub, ring = path_nodes(mesh)
+    inp = write_path_inp(tmp_path / "contact.inp", emesh, hub, ring, law, theta, PathIncrements(max_rad=0.02), deck)
+    return path, run_ccx_path(inp, emesh.nodes_m, theta)
+
+
+@pytest.mark.slow
+def test_calculix_contact_pair_agrees_through_contact(tmp_path, ccx):
+    """3 x 8 mm through contact to 0.42 rad (first contact 0.318 rad): before contact CalculiX's contact pair stays
+    open and the torques agree as without contact (measured 1.5e-8, and 9.4e-5 at 0.286 rad, 0.03 rad before our
+    first contact: CalculiX's face-to-face contact starts to push before the faces touch); through contact they
+    agree within 4.5e-4 (measured; the issue asks 1 %). Ours 16 s, CalculiX 86 s on 2 cores."""
+    path, cc = _through_contact(tmp_path, 3, 8.0, 0.42)
+    assert cc.failure is None and len(cc.rotation_rad) == len(path.points) - 1
+    (event,) = path.events
+    ours = np.array([p.torque_Nm for p in path.points[1:]])
+    difference = np.abs(cc.torque_Nm / ours - 1.0)
+    assert difference[cc.rotation_rad < 0.27].max() < RTOL
+    assert difference[cc.rotation_rad >= event.rotation_rad].max() < 1e-3
+    assert difference.max() < 1e-3

@@ -24,6 +24,7 @@ import numpy as np
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import SolverError
+from seadesign.fea.ccx_contact import ContactPairDeck
 from seadesign.fea.elements import ElementMesh, element_mesh
 from seadesign.fea.hub_rotation import HubRotation, moment_z
 from seadesign.fea.torsion import MM, UnitTorsion
@@ -241,12 +242,14 @@ def write_path_inp(
     law: Hyperelastic,
     rotations_rad: Sequence[float],
     increments: PathIncrements = PathIncrements(),
+    contact: ContactPairDeck | None = None,
 ) -> Path:
     """Write a CalculiX NLGEOM deck of the rotation path: the hyperelastic law (`hyperelastic_card`;
     C3D10 integrates it at every point, as the path's formulation "full"), the ring nodes held, the hub
     nodes' u_z = 0, and one *STEP, NLGEOM per rotation (rad, increasing) that ends with every hub node
     at x' = R(theta) x about z (within a step the displacements ramp linearly: only step ends are
-    read). Each step prints the hub nodes' displacements and reaction forces at its end only."""
+    read). Each step prints the hub nodes' displacements and reaction forces at its end only. `contact`: a contact
+    pair between two sets of the part's boundary facets (the check of the path through self-contact)."""
     card = hyperelastic_card(law)
     theta = np.asarray(rotations_rad, dtype=float)
     if theta.ndim != 1 or not len(theta) or theta[0] <= 0 or np.any(np.diff(theta) <= 0):
@@ -262,6 +265,8 @@ def write_path_inp(
         _write_mesh(f, emesh, hub, ring_nodes)
         f.write(f"*MATERIAL, NAME=SPRING\n{card}")
         f.write("*SOLID SECTION, ELSET=EALL, MATERIAL=SPRING\n*BOUNDARY\nRING, 1, 3\nHUB, 3, 3\n")
+        if contact is not None:
+            f.write(contact.card(emesh.elements))
         for before, t in zip(np.concatenate([[0.0], theta[:-1]]), theta):
             c, s = np.cos(t), np.sin(t)
             u = np.column_stack([(c - 1) * x - s * y, s * x + (c - 1) * y]).ravel()
