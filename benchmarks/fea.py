@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/fea.py [--study wolfgang_knee] [--beams 8] [--thickness-mm 6]
        [--coarsening C] [--elements-across-beam N] [--backend gmsh|pytetwild] [--no-ccx]
-       [--no-path] [--max-rotation-rad 0.4]
+       [--no-path] [--max-rotation-rad 0.4] [--contact]
 Prints machine, settings, per-stage seconds and the ratio (our assembly + factorization + solve)
 / (ccx wall time, which includes its own input reading, assembly and solve). Then the
 large-deflection path on the sweep's path mesh (the same sizing with SolverSettings.path_layers layers
@@ -31,8 +31,11 @@ import numpy as np
 
 from seadesign.fea import rotation_path as rp
 from seadesign.fea.assembly import UpperBlocks
+from seadesign.fea.ccx_contact import pair_around
+from seadesign.fea.contact import FrictionlessContact
 from seadesign.fea.facing import FacingSurfaces
-from seadesign.fea.ccx import path_nodes, run_ccx, run_ccx_path, write_load_case_decks, write_path_inp
+from seadesign.fea.ccx import (PathIncrements, path_nodes, run_ccx, run_ccx_path, write_load_case_decks,
+                               write_path_inp)
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.loadcases import analyse
 from seadesign.fea.pardiso import Pardiso
@@ -53,6 +56,10 @@ PATH_PARTS = {
     "factorization (LDL^T with inertia)": [(Pardiso, "__init__"), (Pardiso, "refactor")],
     "solve": [(Pardiso, "solve")],
     "stop checks (peak strain, contact gap)": [(Solid, "element_strain_stress"), (FacingSurfaces, "min_gap_mm")],
+    "contact search": [(FrictionlessContact, "search")],
+    "contact terms (forces, tangent blocks, energy)": [(FrictionlessContact, "forces"),
+                                                       (FrictionlessContact, "tangent_blocks"),
+                                                       (FrictionlessContact, "energy")],
 }
 
 
@@ -93,6 +100,8 @@ def main() -> None:
     ap.add_argument("--no-ccx", action="store_true")
     ap.add_argument("--no-path", action="store_true", help="skip the large-deflection path")
     ap.add_argument("--max-rotation-rad", type=float, default=0.4, help="where the path stops at the latest")
+    ap.add_argument("--contact", action="store_true", help="the path through frictionless self-contact (the study's "
+                    "self_contact), and CalculiX with a face-to-face contact pair where ours touches at the end")
     args = ap.parse_args()
     st = load_study(args.study)
     sizing = st.mesh.scaled(1.0 / args.coarsening)
@@ -146,7 +155,7 @@ def main() -> None:
     else:
         linear_ccx(a, m, lc, r)
     if not args.no_path:
-        path_benchmark(path_mesh, m, lc, args.max_rotation_rad, use_ccx)
+        path_benchmark(path_mesh, m, lc, args.max_rotation_rad, use_ccx, args.contact)
 
 
 def linear_ccx(a, m, lc, r: dict) -> None:
@@ -164,19 +173,23 @@ def linear_ccx(a, m, lc, r: dict) -> None:
     print(f"ours (assembly + factorization + solve) / CalculiX = {ours:.2f} / {cc.wall_s:.2f} = {ours / cc.wall_s:.2f}")
 
 
-def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool) -> None:
+def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool, contact: bool) -> None:
     """The large-deflection path on the sweep's path mesh (this sizing, SolverSettings.path_layers layers through
-    the thickness) with its time split, and CalculiX NLGEOM at the path's rotations."""
+    the thickness) with its time split, and CalculiX NLGEOM at the path's rotations (through contact: with a
+    face-to-face contact pair, ten times our penalty, on the faces within 1.5 mm of where ours touches at the end)."""
     law = m.law
     print(f"path mesh: {len(mesh.tets)} tets, {SolverSettings().path_layers} layer(s) through the thickness")
+    settings = rp.PathSettings(max_rotation_rad=max_rotation_rad)
+    settings = rp.through_contact(settings) if contact else settings
     with timed(PATH_PARTS) as parts:
-        path = rp.rotation_path(mesh, law, lc.stall_torque_Nm, rp.PathSettings(max_rotation_rad=max_rotation_rad))
+        path = rp.rotation_path(mesh, law, lc.stall_torque_Nm, settings)
     points = path.points[1:]
     its = np.array([p.iterations for p in points])
     factorizations = parts["factorization (LDL^T with inertia)"][1]
     print(f"large-deflection path (neo-Hooke C10 {law.c10_Pa / 1e6:.3g} MPa, D1 {law.d1_per_Pa * 1e6:.3g} 1/MPa; "
           f"formulation full; to {lc.stall_torque_Nm:g} Nm or {max_rotation_rad:g} rad): stopped by {path.stop_reason} "
-          f"at {path.stop_rotation_rad:.4f} rad, {path.stop_torque_Nm:.4g} Nm")
+          f"at {path.stop_rotation_rad:.4f} rad, {path.stop_torque_Nm:.4g} Nm"
+          + "".join(f"; {e.kind} at {e.rotation_rad:.4f} rad, {e.torque_Nm:.4g} Nm" for e in path.events))
     print(f"{len(points)} increments accepted, {path.cut_backs} cut back; Newton iterations per accepted increment "
           f"{its.mean():.2f} (max {its.max()}); {factorizations} tangent factorizations and "
           f"{parts['solve'][1]} solves in all (cut-back attempts included); MKL threads "
@@ -192,11 +205,17 @@ def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool) -> None:
         return
     theta = [p.rotation_rad for p in points]
     emesh, hub, ring = path_nodes(mesh)
+    deck = None
+    if contact and path.events:
+        touch = rp.path_problem(mesh, law, settings).system.contact
+        deck = pair_around(touch, path.displacement_m, 1.5, 10 * touch.penalty_Pa_per_m)
     with tempfile.TemporaryDirectory() as d:
-        cc = run_ccx_path(write_path_inp(Path(d) / "path.inp", emesh, hub, ring, law, theta), emesh.nodes_m, theta)
+        inp = write_path_inp(Path(d) / "path.inp", emesh, hub, ring, law, theta,
+                             PathIncrements(max_rad=0.02) if deck else PathIncrements(), deck)
+        cc = run_ccx_path(inp, emesh.nodes_m, theta)
     n = len(cc.torque_Nm)
     diff = np.abs(cc.torque_Nm / np.array([p.torque_Nm for p in points[:n]]) - 1)
-    print(f"CalculiX NLGEOM {os.cpu_count()} threads (SPOOLES), same mesh, the path's {len(theta)} rotations: "
+    print(f"CalculiX NLGEOM{' with a contact pair' if deck else ''} {os.cpu_count()} threads (SPOOLES), same mesh, the path's {len(theta)} rotations: "
           f"{cc.wall_s:.2f} s wall, {cc.increments} increments, {cc.iterations} iterations "
           f"({cc.iterations / cc.increments:.2f} per increment, {1e3 * cc.wall_s / cc.iterations:.0f} ms each)"
           + (f"; did not converge: {cc.failure}" if cc.failure else ""))

@@ -33,7 +33,7 @@ SI units throughout; mesh coordinates arrive in mm.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -69,6 +69,13 @@ class PathSettings:
     allowable_strain: float | None = None  # engineering strain; None: no strain stop
     contact: ContactSettings | None = None  # frictionless self-contact through which the path goes on; None: the
     # path stops where facing surfaces come within `contact_gap_mm`
+
+
+def through_contact(settings: PathSettings) -> PathSettings:
+    """`settings` with frictionless self-contact, and 60 Newton iterations an attempt: a creasing notch's active set
+    takes that many to settle (on the 3 x 8 mm candidate's coarse mesh 30 reached 0.558 rad in 104 s and ended
+    unconverged, 60 reached 0.6 rad in 62 s)."""
+    return replace(settings, contact=ContactSettings(), newton=replace(settings.newton, max_iterations=60))
 
 
 @dataclass

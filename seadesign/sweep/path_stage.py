@@ -16,11 +16,9 @@ import numpy as np
 
 from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
-from seadesign.fea.contact import ContactSettings
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.large_deflection import LargeDeflection, large_deflection
-from seadesign.fea.newton import NewtonSettings
-from seadesign.fea.rotation_path import PathSettings, rotation_path
+from seadesign.fea.rotation_path import PathSettings, rotation_path, through_contact
 from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.fingerprint import code_fingerprint
 from seadesign.sweep.stages import Progress, SolverSettings, mesh_key, tetrahedralize
@@ -44,12 +42,8 @@ class PathResponse:
 
 
 def path_settings(study: Study) -> PathSettings:
-    """The path's settings: with the study's `[ranking] self_contact`, through frictionless self-contact, with 60
-    Newton iterations an attempt (a creasing notch's active set takes that many to settle: on the 3 x 8 mm
-    candidate's coarse mesh 30 reached 0.558 rad in 104 s and ended unconverged, 60 reached 0.6 rad in 62 s)."""
-    if not study.ranking.self_contact:
-        return PathSettings()
-    return PathSettings(contact=ContactSettings(), newton=NewtonSettings(max_iterations=60))
+    """The path's settings: with the study's `[ranking] self_contact`, through frictionless self-contact."""
+    return through_contact(PathSettings()) if study.ranking.self_contact else PathSettings()
 
 
 def path_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
