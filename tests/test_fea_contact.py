@@ -145,6 +145,19 @@ def test_the_first_pass_over_the_vertices_loses_no_pair_that_can_press():
     assert len(found) > 40 and found == close(everywhere)
 
 
+@pytest.mark.parametrize("depth_mm, paired", [(0.09, True), (0.11, False)])
+def test_a_point_deeper_behind_a_facet_than_the_search_distance_is_not_paired(depth_mm, paired):
+    """A point further than `search_mm` (0.1 mm) behind a facet's plane came into the facet's prism from the side
+    (at a fold of the surface), it did not cross the facet: the top block moved down into the base by `depth_mm`
+    has its bottom paired with the base's top within that depth only."""
+    system, u0, *_ = _blocks(2, 2, True)
+    top = np.unique(system.solid.mesh.elements[6 * 2**2 * 2:])
+    u = np.zeros_like(u0)
+    u[top, 2] = -(GAP_MM + depth_mm) * MM
+    points, facets = system.contact.search(u)
+    assert (len(points) > 0) == paired
+
+
 def test_the_answer_does_not_depend_on_the_penalty():
     reactions = []
     for factor in (10.0, 30.0):  # measured: reactions 4e-8 apart

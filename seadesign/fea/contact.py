@@ -42,7 +42,8 @@ class ContactSettings:
     penetration_tol_mm: float = 0.0045  # 1 % of the default study's 0.45 mm fillet radius
     max_augmentations: int = 30
     search_mm: float = 0.1  # beyond a facet's reach (its largest centroid-to-corner distance), how far from its
-    # centroid a point is paired with it: more than any gap that can carry pressure
+    # centroid a point is paired with it: more than any gap that can carry pressure; and how far behind its plane:
+    # a point deeper than that entered the facet's prism from the side (at a fold), it did not cross the facet
     near_mm: float = 1.0  # the search looks only at faces with a corner vertex this close to a vertex it faces
     # (`NEAR_COSINE`, a gap at rest: a cheap first pass over the vertices; above the in-plane size of the faces
     # where surfaces close)
@@ -180,9 +181,10 @@ class FrictionlessContact:
         until the next assignment, so that the contact energy is smooth in between: a point's gap is its distance
         from its facet's plane, extended past the facet's edges. Candidates, on the faces with a corner within
         `near_mm` of a vertex it faces: a point within a facet's reach (its largest centroid-to-corner distance plus
-        `search_mm`) of its centroid, the point in front of the facet's plane at rest, the point checked against
-        the facet (see `ContactSurface`), the facet not touching the point's face; of these, a point is paired with
-        each facet it projects inside whose normal faces its face's (`FACING_COSINE`)."""
+        `search_mm`) of its centroid and less than `search_mm` behind its plane, the point in front of the facet's
+        plane at rest, the point checked against the facet (see `ContactSurface`), the facet not touching the
+        point's face; of these, a point is paired with each facet it projects inside whose normal faces its face's
+        (`FACING_COSINE`)."""
         s = self.surface
         near = np.isin(s.faces[:, :3], self.vertices.facing_vertices(u, self.settings.near_mm * MM, NEAR_COSINE))
         near = near.any(axis=1)
@@ -211,7 +213,8 @@ class FrictionlessContact:
         gap, n, inside = self._planes(u, q, f)
         own = x[s.faces[q // len(FACE_WEIGHTS), :3]]
         opposed = np.einsum("pi,pi->p", n, _unit(np.cross(own[:, 1] - own[:, 0], own[:, 2] - own[:, 0]))) < FACING_COSINE
-        q, f = q[opposed & inside], f[opposed & inside]
+        shallow = gap > -self.settings.search_mm * MM
+        q, f = q[opposed & inside & shallow], f[opposed & inside & shallow]
         order = np.argsort(q * len(s.facets) + f)
         return q[order], f[order]
 
