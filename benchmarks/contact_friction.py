@@ -1,0 +1,85 @@
+"""What frictionless contact leaves out: CalculiX with a Coulomb friction coefficient against CalculiX frictionless,
+on the same mesh and contact pair, beside our (frictionless) path through contact.
+
+Usage: python benchmarks/contact_friction.py [--beams 6] [--thickness-mm 8] [--coarsening 4] [--max-rotation-rad 0.5]
+       [--friction 0.5] [--docs]
+Our path through self-contact (`fea.rotation_path.through_contact`) on the candidate's one-layer path mesh, coarsened,
+to the impact torque or `--max-rotation-rad`; then CalculiX NLGEOM at the same rotations with a face-to-face contact
+pair (ten times our penalty) on the faces within 1.5 mm of where ours touches at the end, frictionless and with the
+friction coefficient (stick slope the penalty's). Prints each rotation's torques and the frictional torque's
+difference, and the difference at the stall torque (where the frictionless CalculiX curve carries it; else at the
+last rotation both reached). TPU on TPU is far from frictionless, so this bounds the assumption on one candidate.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from record import Table, add_docs_option, machine, write_fragment
+
+from seadesign.design.study import load_study
+from seadesign.fea.ccx import PathIncrements, path_nodes, run_ccx_path, write_path_inp
+from seadesign.fea.ccx_contact import pair_around
+from seadesign.fea.rotation_path import PathSettings, path_problem, rotation_path, through_contact
+from seadesign.run.cache import Cache
+from seadesign.sweep.stages import tetrahedralize
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--beams", type=int, default=6)
+    ap.add_argument("--thickness-mm", type=float, default=8.0)
+    ap.add_argument("--coarsening", type=float, default=4.0)
+    ap.add_argument("--max-rotation-rad", type=float, default=0.5)
+    ap.add_argument("--friction", type=float, default=0.5)
+    add_docs_option(ap, "contact_friction")
+    args = ap.parse_args()
+    study = load_study()
+    lc, law = study.load_cases, study.material.law
+    checked, part = study.check(study.candidate(beam_count=args.beams, beam_thickness_mm=args.thickness_mm))
+    settings = through_contact(PathSettings(max_rotation_rad=args.max_rotation_rad))
+    with tempfile.TemporaryDirectory() as d:
+        mesh = tetrahedralize(study, checked, part, Cache(Path(d)), coarsening=args.coarsening, layers=1)
+        path = rotation_path(mesh, law, lc.impact_torque_Nm, settings)
+        if not path.events:
+            raise SystemExit(f"the path ends ({path.stop_reason}) before any contact: nothing to compare")
+        touch = path_problem(mesh, law, settings).system.contact
+        theta = [p.rotation_rad for p in path.points[1:]]
+        emesh, hub, ring = path_nodes(mesh)
+        runs = {}
+        for mu in (0.0, args.friction):
+            deck = pair_around(touch, path.displacement_m, 1.5, 10 * touch.penalty_Pa_per_m, mu)
+            inp = write_path_inp(Path(d) / f"friction_{mu:g}.inp", emesh, hub, ring, law, theta, PathIncrements(max_rad=0.02),
+                                 deck)
+            runs[mu] = run_ccx_path(inp, emesh.nodes_m, theta)
+    free, rough = runs[0.0], runs[args.friction]
+    n = min(len(free.torque_Nm), len(rough.torque_Nm))
+    table = Table(["rotation (rad)", "ours, frictionless (Nm)", "CalculiX, frictionless (Nm)",
+                   f"CalculiX, friction {args.friction:g} (Nm)", "friction's change"])
+    for i in range(n):
+        table.add(f"{theta[i]:.4f}", f"{path.points[i + 1].torque_Nm:.4f}", f"{free.torque_Nm[i]:.4f}",
+                  f"{rough.torque_Nm[i]:.4f}", f"{rough.torque_Nm[i] / free.torque_Nm[i] - 1:+.2%}")
+    event = path.events[0]
+    at = np.flatnonzero(free.torque_Nm[:n] >= lc.stall_torque_Nm)
+    i = int(at[0]) if len(at) else n - 1
+    where = "the first rotation carrying the stall torque" if len(at) else "the last rotation both reached"
+    summary = (f"Friction {args.friction:g} changes the torque by {rough.torque_Nm[i] / free.torque_Nm[i] - 1:+.2%} at "
+               f"{theta[i]:.4f} rad ({where}; stall torque {lc.stall_torque_Nm:g} Nm). First contact at "
+               f"{event.rotation_rad:.4f} rad, {event.torque_Nm:.3g} Nm; our path ends: {path.stop_reason} at "
+               f"{path.stop_rotation_rad:.4f} rad, {path.stop_torque_Nm:.4g} Nm.")
+    settings_text = (f"{args.beams} beams x {args.thickness_mm:g} mm, path mesh {args.coarsening:g}x coarser "
+                     f"({len(mesh.tets)} tetrahedra), to {args.max_rotation_rad:g} rad; CalculiX {free.wall_s:.0f} s "
+                     f"frictionless, {rough.wall_s:.0f} s with friction")
+    print(f"machine: {machine()}\n{settings_text}\n{table.markdown()}\n{summary}")
+    for name, run in (("frictionless", free), (f"friction {args.friction:g}", rough)):
+        if run.failure:
+            print(f"CalculiX {name} did not converge past {run.reached_rad:.4f} rad: {run.failure}")
+    if args.docs:
+        write_fragment("contact_friction", table, settings_text, summary)
+
+
+if __name__ == "__main__":
+    main()
