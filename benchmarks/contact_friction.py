@@ -2,10 +2,10 @@
 on the same mesh and contact pair, beside our (frictionless) path through contact.
 
 Usage: python benchmarks/contact_friction.py [--beams 6] [--thickness-mm 8] [--coarsening 4] [--max-rotation-rad 0.5]
-       [--friction 0.5] [--docs]
+       [--friction 0.5] [--reach-mm 1.5] [--docs]
 Our path through self-contact (`fea.rotation_path.through_contact`) on the candidate's one-layer path mesh, coarsened,
 to the impact torque or `--max-rotation-rad`; then CalculiX NLGEOM at the same rotations with a face-to-face contact
-pair (ten times our penalty) on the faces within 1.5 mm of where ours touches at the end, frictionless and with the
+pair (ten times our penalty) on the faces within `--reach-mm` of where ours touches at the end, frictionless and with the
 friction coefficient (stick slope the penalty's). Prints each rotation's torques and the frictional torque's
 difference, and the difference at the stall torque (where the frictionless CalculiX curve carries it; else at the
 last rotation both reached). TPU on TPU is far from frictionless, so this bounds the assumption on one candidate.
@@ -35,6 +35,7 @@ def main() -> None:
     ap.add_argument("--coarsening", type=float, default=4.0)
     ap.add_argument("--max-rotation-rad", type=float, default=0.5)
     ap.add_argument("--friction", type=float, default=0.5)
+    ap.add_argument("--reach-mm", type=float, default=1.5, help="the contact pair's faces: within this of where ours touch")
     add_docs_option(ap, "contact_friction")
     args = ap.parse_args()
     study = load_study()
@@ -51,7 +52,7 @@ def main() -> None:
         emesh, hub, ring = path_nodes(mesh)
         runs = {}
         for mu in (0.0, args.friction):
-            deck = pair_around(touch, path.displacement_m, 1.5, 10 * touch.penalty_Pa_per_m, mu)
+            deck = pair_around(touch, path.displacement_m, args.reach_mm, 10 * touch.penalty_Pa_per_m, mu)
             inp = write_path_inp(Path(d) / f"friction_{mu:g}.inp", emesh, hub, ring, law, theta, PathIncrements(max_rad=0.02),
                                  deck)
             runs[mu] = run_ccx_path(inp, emesh.nodes_m, theta)
@@ -71,7 +72,8 @@ def main() -> None:
                f"{event.rotation_rad:.4f} rad, {event.torque_Nm:.3g} Nm; our path ends: {path.stop_reason} at "
                f"{path.stop_rotation_rad:.4f} rad, {path.stop_torque_Nm:.4g} Nm.")
     settings_text = (f"{args.beams} beams x {args.thickness_mm:g} mm, path mesh {args.coarsening:g}x coarser "
-                     f"({len(mesh.tets)} tetrahedra), to {args.max_rotation_rad:g} rad; CalculiX {free.wall_s:.0f} s "
+                     f"({len(mesh.tets)} tetrahedra), to {args.max_rotation_rad:g} rad; contact pair within "
+                     f"{args.reach_mm:g} mm of where ours touches; CalculiX {free.wall_s:.0f} s "
                      f"frictionless, {rough.wall_s:.0f} s with friction")
     print(f"machine: {machine()}\n{settings_text}\n{table.markdown()}\n{summary}")
     for name, run in (("frictionless", free), (f"friction {args.friction:g}", rough)):

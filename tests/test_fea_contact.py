@@ -158,6 +158,15 @@ def test_a_point_deeper_behind_a_facet_than_the_search_distance_is_not_paired(de
     assert (len(points) > 0) == paired
 
 
+def test_multipliers_are_extrapolated_linearly_and_never_below_zero():
+    before = Multipliers(np.array([1, 4]), np.array([2.0, 5.0]))
+    last = Multipliers(np.array([1, 4, 7]), np.array([3.0, 1.0, 6.0]))  # pair 7 is new: it had 0
+    ahead = last.extrapolated(before, 0.5)
+    np.testing.assert_array_equal(ahead.keys, last.keys)
+    np.testing.assert_allclose(ahead.values_Pa, [3.5, 0.0, 9.0])  # 1 + 0.5 (1 - 5) = -1 is held at 0
+    assert last.extrapolated(before, 0.0) is last
+
+
 def test_the_answer_does_not_depend_on_the_penalty():
     reactions = []
     for factor in (10.0, 30.0):  # measured: reactions 4e-8 apart

@@ -143,6 +143,13 @@ class Multipliers:
     def none(cls) -> "Multipliers":
         return cls(np.empty(0, dtype=np.int64), np.empty(0))
 
+    def extrapolated(self, before: "Multipliers", ratio: float) -> "Multipliers":
+        """These multipliers plus `ratio` times their change since `before` (a pair `before` lacks had 0), none
+        below 0: a predictor of the next increment's, as the path's displacements are predicted."""
+        if ratio == 0 or not len(self.keys):
+            return self
+        return Multipliers(self.keys, np.maximum(self.values_Pa + ratio * (self.values_Pa - before.at(self.keys)), 0.0))
+
     def at(self, keys: np.ndarray) -> np.ndarray:
         """The multipliers of the pairs `keys` (0 for a pair not kept)."""
         if not len(self.keys):

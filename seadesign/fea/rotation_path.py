@@ -159,13 +159,14 @@ def rotation_path(
         snapshot, probe = None, None  # probe: the last attempt rejected for contact since the last point
         events: list[PathEvent] = []
         held = None if p.system.contact is None else p.system.contact.multipliers  # the last point's multipliers
+        held_before = held  # the point's before it
         while reason is None:
             last = points[-1]
             step = min(step, settings.max_step_rad, settings.max_rotation_rad - last.rotation_rad)
             theta = last.rotation_rad + step
             guess = _predict(p, u, v, step, previous, last.rotation_rad)
             guess[p.drive.hub] = p.drive.displacement(theta)
-            solved = _solve(p, guess, held)
+            solved = _solve(p, guess, held, held_before, step / (last.rotation_rad - previous[1]) if previous else 0.0)
             trial, forces, norms, status = solved.u, solved.forces, solved.residual_norms, solved.status
             event = None
             if status == "converged":
@@ -194,7 +195,7 @@ def rotation_path(
             else:
                 if p.system.contact is not None and not events and point.contact.area_m2 > 0:
                     events.append(contact_event(last, point, p.system.contact.closing_fraction(u, trial)))
-                held = None if p.system.contact is None else p.system.contact.multipliers
+                held_before, held = held, None if p.system.contact is None else p.system.contact.multipliers
                 points.append(point)
                 if snapshot is None and snapshot_torque_Nm is not None and point.torque_Nm >= snapshot_torque_Nm:
                     snapshot = (len(points) - 1, trial)
@@ -213,12 +214,14 @@ def rotation_path(
                       time.perf_counter() - t0, index, shot, tuple(events))
 
 
-def _solve(p: PathProblem, guess: np.ndarray, held: Multipliers | None) -> NewtonResult:
-    """Newton from the guess; with contact, the augmented Lagrangian from the last converged point's
-    multipliers `held` (every attempt, a cut-back's too, starts from them)."""
+def _solve(p: PathProblem, guess: np.ndarray, held: Multipliers | None, held_before: Multipliers | None,
+           ratio: float) -> NewtonResult:
+    """Newton from the guess; with contact, the augmented Lagrangian from the multipliers extrapolated linearly
+    from the last two converged points' (`held`, `held_before`; `ratio`: the step over the last one), so that every
+    attempt, a cut-back's too, starts from the converged ones."""
     if p.system.contact is None:
         return newton(p.system, guess, p.settings.newton)
-    p.system.contact.multipliers = held
+    p.system.contact.multipliers = held.extrapolated(held_before, ratio)
     return newton_augmented(p.system, guess, p.settings.newton)
 
 
