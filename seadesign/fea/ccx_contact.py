@@ -61,23 +61,21 @@ class ContactPairDeck:
 
 def pair_around(contact: FrictionlessContact, u: np.ndarray, reach_mm: float, penalty_Pa_per_m: float,
                 friction: float = 0.0) -> ContactPairDeck:
-    """The slave and master surfaces around the pairs that touch at u (our path's solution; gap below
-    `TOUCHING_MM`): the faces of
-    `contact`'s surface within `reach_mm` of a pressed pair's face at rest, each given to
-    the side of the nearest pair whose face it turns like (the checked point's face: slave; the facet's face: master),
-    a facet turned like neither (cosine 0.3 or less) to none. `friction`: Coulomb's coefficient, with the stick slope
-    the penalty's."""
+    """The slave and master surfaces around the pairs that touch at u (our path's solution; gap below `TOUCHING_MM`):
+    the faces of `contact`'s surface within `reach_mm` of a touching pair's face at rest, each given to the side of
+    the nearest pair whose face it turns like (the checked point's face: slave; the facet's face: master), a face
+    turned like neither (cosine 0.3 or less) to none. `friction`: Coulomb's coefficient, with the stick slope the
+    penalty's."""
     pairs = contact.pairs(u, contact.search(u))
     touching = pairs.gap_m < TOUCHING_MM * MM
     if not touching.any():
         raise SolverError("no surfaces touch at this state: there is no pair to check")
-    pressed = np.column_stack([pairs.point[touching], pairs.facet[touching]])
     corners = contact.surface.faces[:, :3]
     x = contact.surface.nodes_m[corners] / MM
     centroids = x.mean(axis=1)
     normals = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
     normals /= np.linalg.norm(normals, axis=1)[:, None]
-    slave, master = pressed[:, 0] // len(FACE_POINTS), pressed[:, 1] // len(SUBFACETS)
+    slave, master = pairs.point[touching] // len(FACE_POINTS), pairs.facet[touching] // len(SUBFACETS)
     seeds = np.concatenate([slave, master])
     distance = np.linalg.norm(centroids[:, None] - centroids[seeds][None], axis=2)
     nearest = np.argmin(distance, axis=1) % len(slave)

@@ -339,8 +339,8 @@ class FrictionlessContact:
         self.multipliers = Multipliers(keys[order], self.pressure_Pa(pairs)[order])
 
     def closing_fraction(self, u0: np.ndarray, u1: np.ndarray) -> float:
-        """How far (0 to 1) from u0 to u1, the gaps linear in between, the first of the pairs pressed at u1 touches
-        (their multipliers taken as zero: contact first carrying pressure); 1 when no pair is pressed at u1."""
+        """How far (0 to 1) from u0 to u1, the gaps linear in between, the first of the pairs pressed at u1 closes
+        its gap; 1 when no pair is pressed at u1 or none closes."""
         active = self.active(u1)
         if not len(active):
             return 1.0
