@@ -2,7 +2,7 @@
 on the same mesh and contact pair, beside our (frictionless) path through contact.
 
 Usage: python benchmarks/contact_friction.py [--beams 6] [--thickness-mm 8] [--coarsening 4] [--max-rotation-rad 0.5]
-       [--friction 0.5] [--reach-mm 1.5] [--docs]
+       [--friction 0.5] [--reach-mm 1.5]
 Our path through self-contact (`fea.rotation_path.through_contact`) on the candidate's one-layer path mesh, coarsened,
 to the impact torque or `--max-rotation-rad`; then CalculiX NLGEOM at the same rotations with a face-to-face contact
 pair (ten times our penalty) on the faces within `--reach-mm` of where ours touches at the end, frictionless and with the
@@ -18,7 +18,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from record import Table, add_docs_option, machine, write_fragment
+from record import Table, machine
 
 from seadesign.design.study import load_study
 from seadesign.fea.ccx import PathIncrements, path_nodes, run_ccx_path, write_path_inp
@@ -36,7 +36,6 @@ def main() -> None:
     ap.add_argument("--max-rotation-rad", type=float, default=0.5)
     ap.add_argument("--friction", type=float, default=0.5)
     ap.add_argument("--reach-mm", type=float, default=1.5, help="the contact pair's faces: within this of where ours touch")
-    add_docs_option(ap, "contact_friction")
     args = ap.parse_args()
     study = load_study()
     lc, law = study.load_cases, study.material.law
@@ -79,8 +78,6 @@ def main() -> None:
     for name, run in (("frictionless", free), (f"friction {args.friction:g}", rough)):
         if run.failure:
             print(f"CalculiX {name} did not converge past {run.reached_rad:.4f} rad: {run.failure}")
-    if args.docs:
-        write_fragment("contact_friction", table, settings_text, summary)
 
 
 if __name__ == "__main__":
