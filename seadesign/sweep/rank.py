@@ -157,7 +157,7 @@ def unblock(row: pd.Series, study: Study) -> str:
     if any(row.get(f"{load}_travel_margin", 0.0) < 0 for load in study.requirements.loads):
         reason = row["large_stop_reason"]
         hints.append(f"its path ends in {reason} before a load: contact carrying the load past the closing gap "
-                     "(self-contact in the path) or a larger envelope" if reason == "contact" else
+                     "(the study's [ranking] self_contact = true) or a larger envelope" if reason == "contact" else
                      f"its path ends in {reason} before a load: a stiffer material or a larger envelope")
     if row.get("torque_resolution_margin", 0.0) < 0 or row.get("k_max_margin", 0.0) < 0:
         hints.append("a softer spring (thinner or fewer beams, a softer material)")
