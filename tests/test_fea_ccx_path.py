@@ -143,7 +143,7 @@ def test_calculix_contact_pair_agrees_through_contact(tmp_path, ccx):
     """3 x 8 mm through contact to 0.42 rad (first contact 0.318 rad): before contact CalculiX's contact pair stays
     open and the torques agree as without contact (measured 1.5e-8, and 9.4e-5 at 0.286 rad, 0.03 rad before our
     first contact: CalculiX's face-to-face contact starts to push before the faces touch); through contact they
-    agree within 4.5e-4 (measured; the issue asks 1 %). Ours 16 s, CalculiX 86 s on 2 cores."""
+    agree within 4.5e-4 (measured; the issue asks 1 %). Ours 12 s, CalculiX 64 s on 2 cores."""
     path, cc = _through_contact(tmp_path, 3, 8.0, 0.42)
     assert cc.failure is None and len(cc.rotation_rad) == len(path.points) - 1
     (event,) = path.events
