@@ -295,3 +295,57 @@ def test_dahl_in_series_shares_the_torque_with_the_spring(torque, stiffness):
         ref.append(z)
     # measured: at most 4.2e-13 tau_h (the plain `dahl` of x, the loop not sharing the torque, is off by 0.08-1.4 tau_h)
     np.testing.assert_allclose(dahl_in_series(x, torque, stiffness, K), ref, rtol=0, atol=1.5e-12 * torque)
+
+
+def test_torque_curve_pieces_are_scipys_pchip_to_the_last_digit_and_differentiate_in_torch():
+    """The curve is evaluated from its PCHIP pieces in any array namespace: NumPy gives scipy's `PchipInterpolator`
+    exactly (the same sums in the same order), torch the same values to round-off, and a gradient that is the
+    interpolant's derivative."""
+    import array_api_compat.torch as xp
+    import torch
+    from scipy.interpolate import PchipInterpolator
+
+    curve = TorqueCurve(CURVE_RAD, CURVE_NM)
+    th = np.random.default_rng(4).uniform(-CURVE_RAD[-1], CURVE_RAD[-1], 20000)
+    th[:len(CURVE_RAD)] = CURVE_RAD
+    pchip = PchipInterpolator(CURVE_RAD, CURVE_NM)
+    assert np.array_equal(curve.torque(th), np.sign(th) * pchip(np.abs(th)))
+    t = torch.tensor(th, requires_grad=True)
+    tq = curve.torque(t, xp=xp)
+    tq.sum().backward()
+    np.testing.assert_allclose(tq.detach().numpy(), curve.torque(th), rtol=0, atol=1e-14)  # measured 0
+    moving = th != 0  # sign(theta) has no gradient at 0
+    np.testing.assert_allclose(t.grad.numpy()[moving], pchip.derivative()(np.abs(th[moving])), rtol=1e-12, atol=1e-12)
+    with pytest.raises(CurveRangeError, match="past the spring's torque curve"):
+        curve.torque(torch.tensor([CURVE_RAD[-1] * 1.01]), xp=xp)
+
+
+@pytest.mark.parametrize("key", sorted(LIBRARY))
+def test_one_step_definition_gives_numpy_and_torch_the_same_numbers(key):
+    """Each effect's time step is written once (`Effect.advance` against an array namespace): stepped on torch
+    tensors (exact options) it gives what it gives on NumPy arrays, sample by sample, states included; a random
+    effect draws from the stream it is given."""
+    import array_api_compat.torch as xp
+    import torch
+
+    effect = LIBRARY[key](**STEPPING.get(key, {}))
+    sig = _signals()
+    batch = {k: np.stack([v, 0.7 * v]) for k, v in sig.items()}  # a batch of two, time last
+    tensors = {k: torch.tensor(v) for k, v in batch.items()}
+
+    class Draws:  # the same "draws" for both namespaces
+        def __init__(self, ones):
+            self.ones = ones
+
+        def standard_normal(self, shape):
+            return 0.01 * self.ones(shape, dtype=float)
+
+    state_np = effect.init_state({k: v[:, 0] for k, v in batch.items()})
+    state_t = effect.init_state({k: v[:, 0] for k, v in tensors.items()}, None, xp)
+    worst = 0.0
+    for i in range(0, T.size, 7):
+        dt = float(T[i] - T[i - 7]) if i else 0.0
+        a, state_np = effect.advance(state_np, {k: v[:, i] for k, v in batch.items()}, dt, rng=Draws(np.ones))
+        b, state_t = effect.advance(state_t, {k: v[:, i] for k, v in tensors.items()}, dt, rng=Draws(torch.ones), xp=xp)
+        worst = max(worst, float(np.abs(b.numpy() - a).max()))
+    assert worst <= 1e-15  # measured 0

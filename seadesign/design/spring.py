@@ -162,15 +162,31 @@ class TorqueCurve:
             lo, hi = (mid, hi) if stored(mid) < energy_J else (lo, mid)
         return float(self._pchip()(0.5 * (lo + hi)))
 
-    def torque(self, rotation_rad: np.ndarray, clamp: bool = False) -> np.ndarray:
+    def torque(self, rotation_rad: Any, clamp: bool = False, xp: Any = np) -> Any:
         """T(theta) (Nm), odd in theta; past the end: the end torque with a hard stop or `clamp` (a fitter's trial
-        values, samples the fit leaves out), else CurveRangeError."""
-        th = np.asarray(rotation_rad, dtype=float)
-        a = np.abs(th)
-        past = a > self.end_rotation_rad
-        if past.any() and not (self.hard_stop or clamp):
-            raise CurveRangeError(f"rotation {float(a.max()):.4g} rad is past the spring's torque curve: {self._end()}")
-        return np.sign(th) * self._pchip()(np.minimum(a, self.end_rotation_rad))
+        values, samples the fit leaves out), else CurveRangeError. `xp`: the namespace of `rotation_rad` (NumPy, or
+        `array_api_compat`'s torch, through which it differentiates)."""
+        th = np.asarray(rotation_rad, dtype=float) if xp is np else rotation_rad
+        a = xp.abs(th)
+        if not (self.hard_stop or clamp) and bool(xp.any(a > self.end_rotation_rad)):
+            raise CurveRangeError(f"rotation {float(xp.max(a)):.4g} rad is past the spring's torque curve: {self._end()}")
+        end = self.end_rotation_rad
+        return xp.sign(th) * self._interpolate(xp.where(a > end, end, a), xp)  # at the end: the slope from the left
+
+    def _interpolate(self, a: Any, xp: Any) -> Any:
+        """The PCHIP interpolant at 0 <= a <= end (rad): its polynomial pieces summed in the order scipy's `PPoly`
+        sums them, so that NumPy gives scipy's values to the last digit (tested) and any namespace differentiates."""
+        pchip = self._pchip()
+        key = (xp.__name__, str(a.dtype), str(getattr(a, "device", "cpu")))
+        cache = self.__dict__.setdefault("_pieces", {})
+        if key not in cache:
+            cache[key] = (xp.asarray(pchip.x, dtype=a.dtype, device=getattr(a, "device", None)),
+                          xp.asarray(pchip.c, dtype=a.dtype, device=getattr(a, "device", None)))
+        breaks, coef = cache[key]
+        i = xp.minimum(xp.searchsorted(breaks, a, side="right") - 1, coef.shape[1] - 1)
+        c, s = coef[:, i], a - breaks[i]
+        s2 = s * s
+        return ((c[3] + c[2] * s) + c[1] * s2) + c[0] * (s2 * s)
 
     def rotation(self, torque_Nm: np.ndarray, iterations: int = 60, clamp: bool = False) -> np.ndarray:
         """theta(T) (rad), the exact inverse of `torque`; past the end torque: the end rotation with a hard

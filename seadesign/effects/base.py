@@ -12,17 +12,21 @@ Two uses of the same object:
 - time stepping (the simulators): `init_state(sample, params)` then `step(state, sample, dt,
   params, rng)` once per time step on arrays of the batch shape.
 
-Both give the same result (tested for every effect). Parameters are `Param` records with a
-unit, a default and physical bounds; `params` arguments are mappings name -> value that
-override the instance's values, so a fitter can pass trial values without copying objects.
-Additive effects add to the current value of their target (zero when the signal is absent).
+Both give the same result (tested for every effect). The time step is written once, against an array
+namespace `xp` (NumPy, or torch through `array_api_compat`): `advance` is the step as a function, which the
+NumPy simulators (`step`) and the differentiable torch knee (`twin.torch_knee`) both call; `StepOptions`
+holds the torch knee's smooth departures (softplus dead zones, straight-through quantisation).
+
+Parameters are `Param` records with a unit, a default and physical bounds; `params` arguments are mappings name ->
+value that override the instance's values, so a fitter can pass trial values without copying objects. Additive
+effects add to the current value of their target (zero when the signal is absent).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar, Mapping
+from typing import Any, Callable, ClassVar, Mapping
 
 import numpy as np
 from scipy.signal import lfilter
@@ -30,6 +34,7 @@ from scipy.signal import lfilter
 from seadesign.errors import ConfigError
 
 Signals = Mapping[str, np.ndarray]
+Array = Any  # an array of the step's namespace: a NumPy array or a torch tensor
 
 #: Signal vocabulary: name -> (unit, meaning). Rotations: knee flexion positive.
 SIGNALS: dict[str, tuple[str, str]] = {
@@ -85,6 +90,27 @@ class Scales:
     generic: bool = False  # a table of unknown sign conventions: loads and delays may take either sign
 
 
+@dataclass(frozen=True)
+class StepOptions:
+    """How a time step departs from the exact model, for a simulator that differentiates through it (the torch
+    knee); the default (`EXACT`) is the exact model.
+
+    `dead_zone_smoothing_rad`: None, exact dead zones; s (rad), d -> s softplus((d - b/2) / s) - s softplus((-d - b/2)
+    / s) (it moves a deflection by at most s ln 2); `softplus`: the namespace's softplus (torch's, for its gradient);
+    `stop_gradient`: None, encoders round; a function that detaches an array from its graph, they round with the
+    gradient of the identity (straight-through); `quantise`: False, encoders pass the value through; `noise`:
+    False, noise effects add nothing."""
+
+    dead_zone_smoothing_rad: float | None = None
+    softplus: Callable[[Array], Array] | None = None
+    stop_gradient: Callable[[Array], Array] | None = None
+    quantise: bool = True
+    noise: bool = True
+
+
+EXACT = StepOptions()
+
+
 #: A fit's search space for one effect: bounds name -> (lower, upper) (equal bounds: held fixed) and start points.
 Search = tuple[dict[str, tuple[float, float]], list[dict[str, float]]]
 
@@ -101,6 +127,7 @@ class Effect:
     stateful: ClassVar[bool] = False
     random: ClassVar[bool] = False
     log_params: ClassVar[tuple[str, ...]] = ()  # positive scale parameters a fitter searches in log space
+    batch_params: ClassVar[tuple[str, ...]] = ()  # values that may differ across a batch (they enter as factors)
 
     def __init__(self, name: str | None = None, *, enabled: bool = True,
                  bind: Mapping[str, str] | None = None, **values: float) -> None:
@@ -112,6 +139,7 @@ class Effect:
             raise ConfigError(f"effect '{self.name}': cannot bind {sorted(unknown_roles)}; roles are {self.roles()}")
         self.values = {p.name: float(p.default) for p in self.parameters}
         self.values.update(self._check(values))
+        self._bound = tuple((role, self.signal(role)) for role in self.roles())  # (role, signal name), once
 
     # -- parameters -------------------------------------------------------------------
     def _check(self, values: Mapping[str, float]) -> dict[str, float]:
@@ -162,12 +190,13 @@ class Effect:
         """The signal this effect writes."""
         return self.signal(self.writes)
 
-    def _inputs(self, signals: Signals, like: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    def _inputs(self, signals: Signals, xp: Any = np) -> dict[str, Array]:
+        """The signals of the effect's roles (NumPy: as float arrays; another namespace's as given), an absent
+        additive target as zeros."""
         out = {}
-        for role in self.roles():
-            name = self.signal(role)
+        for role, name in self._bound:
             if name in signals:
-                out[role] = np.asarray(signals[name], dtype=float)
+                out[role] = np.asarray(signals[name], dtype=float) if xp is np else signals[name]
             elif role == self.writes and role not in self.reads:
                 out[role] = None  # an additive target starts at zero
             else:
@@ -176,10 +205,10 @@ class Effect:
                     f"available: {', '.join(signals)}"
                 )
         if out.get(self.writes) is None:
-            ref = next((v for v in out.values() if v is not None), None) if like is None else like
+            ref = next((v for v in out.values() if v is not None), None)
             if ref is None:
                 raise ConfigError(f"effect '{self.name}' needs signal '{self.target()}'; available: {', '.join(signals)}")
-            out[self.writes] = np.zeros_like(ref, dtype=float)
+            out[self.writes] = np.zeros_like(ref, dtype=float) if xp is np else xp.zeros_like(ref)
         return out
 
     # -- forward models ---------------------------------------------------------------
@@ -199,29 +228,43 @@ class Effect:
         x = self._inputs(signals)
         return self._apply_stateful(x, p) if self.stateful else self._map(x, p, None if not self.random else _rng(None))
 
-    def init_state(self, sample: Signals, params: Mapping[str, float] | None = None) -> dict[str, Any]:
-        """State before the first step, from the first sample (batch-shaped arrays)."""
-        return self._init(self._inputs(sample), self.resolve(params)) if self.stateful else {}
+    def init_state(self, sample: Signals, params: Mapping[str, float] | None = None, xp: Any = np) -> dict[str, Any]:
+        """State before the first step, from the first sample (batch-shaped arrays of namespace `xp`)."""
+        return self._init(self._inputs(sample, xp), self.resolve(params), xp) if self.stateful else {}
 
     def step(self, state: dict[str, Any], sample: Signals, dt: float,
              params: Mapping[str, float] | None = None, rng: np.random.Generator | None = None) -> np.ndarray:
-        """New value of the target at one time step of length dt (s); updates `state` in place.
+        """New value of the target at one time step of length dt (s); updates `state` in place (`advance`).
 
         With `params=None` the instance's values are used unchecked (the fast path for simulators).
         """
-        p = self.values if params is None else self.resolve(params)
-        x = self._inputs(sample)
-        if not self.stateful:
-            return self._map(x, p, _rng(rng))
-        return self._advance(state, x, dt, p)
+        value, new = self.advance(state, sample, dt, None if params is None else self.resolve(params), rng)
+        state.update(new)
+        return value
 
-    def _map(self, x: dict[str, np.ndarray], p: dict[str, float], rng: np.random.Generator) -> np.ndarray:
+    def advance(self, state: dict[str, Any], sample: Signals, dt: float, values: Mapping[str, Any] | None = None,
+                rng: Any = None, xp: Any = np, options: StepOptions = EXACT) -> tuple[Array, dict[str, Any]]:
+        """One time step of length dt (s) as a function: (new value of the target, new state); `state` is not
+        changed, and the new one may hold the sample's arrays (do not change them in place). `values`: every
+        parameter's value, taken unchecked (None: the instance's; the `batch_params` may be arrays of the batch
+        shape); `xp`: the namespace of the sample's arrays (NumPy, or `array_api_compat`'s torch); `rng`: a random
+        effect's stream (anything with `standard_normal(shape)`); `options`: a differentiable simulator's departures
+        (`StepOptions`)."""
+        p = self.values if values is None else values
+        x = self._inputs(sample, xp)
+        if not self.stateful:
+            return self._map(x, p, _rng(rng) if self.random else rng, xp, options), state
+        return self._advance(state, x, dt, p, xp, options)
+
+    def _map(self, x: dict[str, Array], p: dict[str, float], rng: Any, xp: Any = np,
+             options: StepOptions = EXACT) -> Array:
         raise NotImplementedError(f"{type(self).__name__} is stateful; use step or apply")
 
-    def _init(self, x: dict[str, np.ndarray], p: dict[str, float]) -> dict[str, Any]:
+    def _init(self, x: dict[str, Array], p: dict[str, float], xp: Any = np) -> dict[str, Any]:
         raise NotImplementedError
 
-    def _advance(self, state: dict[str, Any], x: dict[str, np.ndarray], dt: float, p: dict[str, float]) -> np.ndarray:
+    def _advance(self, state: dict[str, Any], x: dict[str, Array], dt: float, p: dict[str, float], xp: Any = np,
+                 options: StepOptions = EXACT) -> tuple[Array, dict[str, Any]]:
         raise NotImplementedError
 
     def _apply_stateful(self, x: dict[str, np.ndarray], p: dict[str, float]) -> np.ndarray:

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from seadesign.design.spring import TorqueCurve
-from seadesign.effects.base import Effect, Param
+from seadesign.effects.base import EXACT, Effect, Param
 from seadesign.effects.spring import LinearSpring
 
 
@@ -46,8 +46,8 @@ class SpringCurve(Effect):
                            enabled=self.enabled if enabled is None else enabled, bind=self.bind,
                            **{**self.values, **values})
 
-    def _map(self, x, p, rng):
-        return x["torque"] + p["scale"] * self.curve.torque(x["deflection"], clamp=self.clamp)
+    def _map(self, x, p, rng, xp=np, options=EXACT):
+        return x["torque"] + p["scale"] * self.curve.torque(x["deflection"], clamp=self.clamp, xp=xp)
 
     def rotation(self, torque_Nm: np.ndarray, scale: float | None = None, clamp: bool = False) -> np.ndarray:
         """Deflection (rad) at which the scaled curve carries `torque_Nm` (`clamp`: see `TorqueCurve.rotation`)."""

@@ -10,8 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from seadesign.constants import G_M_PER_S2, WOLFGANG_LOWER_LEG_M, WOLFGANG_MASS_KG
-from seadesign.effects.base import Effect, Param, Scales, Search
-
+from seadesign.effects.base import EXACT, Effect, Param, Scales, Search
 
 
 class Friction(Effect):
@@ -29,9 +28,9 @@ class Friction(Effect):
     writes = "load_torque"
     log_params = ("smoothing_rad_per_s",)
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
         v = x["velocity"]
-        return x["load_torque"] + p["coulomb_Nm"] * np.tanh(v / p["smoothing_rad_per_s"]) + p["viscous_Nm_s_per_rad"] * v
+        return x["load_torque"] + p["coulomb_Nm"] * xp.tanh(v / p["smoothing_rad_per_s"]) + p["viscous_Nm_s_per_rad"] * v
 
     def search(self, s: Scales) -> Search:
         span, v = s.torque_Nm, s.velocity_rad_per_s
@@ -54,8 +53,8 @@ class GravityLoad(Effect):
     reads = ("angle",)
     writes = "load_torque"
 
-    def _map(self, x, p, rng):
-        return x["load_torque"] + p["amplitude_Nm"] * np.sin(x["angle"] + p["angle_offset_rad"])
+    def _map(self, x, p, rng, xp=np, options=EXACT):
+        return x["load_torque"] + p["amplitude_Nm"] * xp.sin(x["angle"] + p["angle_offset_rad"])
 
     def search(self, s: Scales) -> Search:
         return ({"amplitude_Nm": (0.0, min(100.0, 2 * s.torque_Nm)), "angle_offset_rad": (-np.pi, np.pi)},
@@ -80,8 +79,8 @@ class StanceLoad(Effect):
     reads = ("angle", "stance")
     writes = "load_torque"
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
         q = x["angle"]
         l1, l2 = p["upper_leg_m"], p["lower_leg_m"]
-        lean = np.arctan2(l1 * np.sin(q), l2 + l1 * np.cos(q))
-        return x["load_torque"] - x["stance"] * p["weight_N"] * l2 * np.sin(lean)
+        lean = xp.atan2(l1 * xp.sin(q), l2 + l1 * xp.cos(q))
+        return x["load_torque"] - x["stance"] * p["weight_N"] * l2 * xp.sin(lean)

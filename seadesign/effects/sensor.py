@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from seadesign.constants import AS5600_BITS
-from seadesign.effects.base import Effect, Param, Scales, Search, lowpass
+from seadesign.effects.base import EXACT, Effect, Param, Scales, Search, lowpass
 
 
 class SensorOffset(Effect):
@@ -24,7 +24,7 @@ class SensorOffset(Effect):
     parameters = (Param("offset_rad", "rad", 0.02, -math.pi, math.pi, "offset c"),)
     writes = "hall"
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
         return x["hall"] + p["offset_rad"]
 
     def search(self, s: Scales) -> Search:
@@ -42,11 +42,11 @@ class SensorDrift(Effect):
     writes = "hall"
     stateful = True
 
-    def _init(self, x, p):
-        return {"t0": np.asarray(x["time"], dtype=float).copy()}
+    def _init(self, x, p, xp=np):
+        return {"t0": x["time"]}
 
-    def _advance(self, state, x, dt, p):
-        return x["hall"] + p["rate_rad_per_s"] * (x["time"] - state["t0"])
+    def _advance(self, state, x, dt, p, xp=np, options=EXACT):
+        return x["hall"] + p["rate_rad_per_s"] * (x["time"] - state["t0"]), state
 
     def _apply_stateful(self, x, p):
         return x["hall"] + p["rate_rad_per_s"] * (x["time"] - x["time"][..., :1])
@@ -75,11 +75,12 @@ class SensorStep(Effect):
     writes = "hall"
     stateful = True  # needs the recording's start time
 
-    def _init(self, x, p):
-        return {"t0": np.asarray(x["time"], dtype=float).copy()}
+    def _init(self, x, p, xp=np):
+        return {"t0": x["time"]}
 
-    def _advance(self, state, x, dt, p):
-        return x["hall"] + p["size_rad"] * (x["time"] - state["t0"] >= p["time_s"])
+    def _advance(self, state, x, dt, p, xp=np, options=EXACT):
+        jumped = xp.astype(x["time"] - state["t0"] >= p["time_s"], x["hall"].dtype)
+        return x["hall"] + p["size_rad"] * jumped, state
 
     def _apply_stateful(self, x, p):
         return x["hall"] + p["size_rad"] * (x["time"] - x["time"][..., :1] >= p["time_s"])
@@ -100,23 +101,23 @@ class SensorDelay(Effect):
     writes = "hall"
     stateful = True
 
-    def _init(self, x, p):
-        return {"times": [], "values": []}
+    def _init(self, x, p, xp=np):
+        return {"times": (), "values": ()}  # the samples since the last one at or before t - td
 
-    def _advance(self, state, x, dt, p):
-        t, v = float(np.max(x["time"])), x["hall"]
-        state["times"].append(t)
-        state["values"].append(np.asarray(v, dtype=float).copy())
+    def _advance(self, state, x, dt, p, xp=np, options=EXACT):
+        t = float(xp.max(x["time"]))
+        times, values = (*state["times"], t), (*state["values"], x["hall"])
         target = t - p["delay_s"]
-        times = state["times"]
-        while len(times) > 2 and times[1] <= target:  # keep one sample at or before the target
-            times.pop(0)
-            state["values"].pop(0)
+        first = 0
+        while len(times) - first > 2 and times[first + 1] <= target:  # keep one sample at or before the target
+            first += 1
+        times, values = times[first:], values[first:]
+        kept = {"times": times, "values": values}
         if target <= times[0] or len(times) == 1:
-            return state["values"][0].copy()
+            return values[0], kept
         i = next(k for k in range(1, len(times)) if times[k] >= target)
         w = (target - times[i - 1]) / (times[i] - times[i - 1])
-        return state["values"][i - 1] + w * (state["values"][i] - state["values"][i - 1])
+        return values[i - 1] + w * (values[i] - values[i - 1]), kept
 
     def _apply_stateful(self, x, p):
         t = np.broadcast_to(x["time"], x["hall"].shape)
@@ -140,8 +141,10 @@ class SensorNoise(Effect):
     writes = "hall"
     random = True
 
-    def _map(self, x, p, rng):
-        return x["hall"] + rng.normal(0.0, p["std_rad"], size=np.shape(x["hall"]))
+    def _map(self, x, p, rng, xp=np, options=EXACT):
+        if not options.noise:
+            return x["hall"]
+        return x["hall"] + p["std_rad"] * rng.standard_normal(tuple(x["hall"].shape))
 
 
 class Quantisation(Effect):
@@ -152,9 +155,13 @@ class Quantisation(Effect):
     parameters = (Param("bits", "bit", float(AS5600_BITS), 1.0, 32.0, "encoder resolution n per revolution"),)
     writes = "hall"
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
+        v = x["hall"]
+        if not options.quantise:
+            return v
         q = 2.0 * math.pi / 2.0 ** p["bits"]
-        return np.round(x["hall"] / q) * q
+        rounded = xp.round(v / q) * q
+        return rounded if options.stop_gradient is None else v + options.stop_gradient(rounded - v)
 
 
 class AngleWrap(Effect):
@@ -165,9 +172,9 @@ class AngleWrap(Effect):
     parameters = (Param("centre_rad", "rad", 0.0, -math.pi, math.pi, "centre c of the output range"),)
     writes = "hall"
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
         c = p["centre_rad"]
-        return np.mod(x["hall"] - c + math.pi, 2.0 * math.pi) - math.pi + c
+        return xp.remainder(x["hall"] - c + math.pi, 2.0 * math.pi) - math.pi + c
 
 
 class EffortLag(Effect):
@@ -187,12 +194,12 @@ class EffortLag(Effect):
     stateful = True
     log_params = ("time_constant_s",)
 
-    def _init(self, x, p):
-        return {"y": np.asarray(x["effort"], dtype=float).copy()}
+    def _init(self, x, p, xp=np):
+        return {"y": x["effort"]}
 
-    def _advance(self, state, x, dt, p):
-        state["y"] = state["y"] + (x["effort"] - state["y"]) * (1.0 - math.exp(-dt / p["time_constant_s"]))
-        return state["y"].copy()
+    def _advance(self, state, x, dt, p, xp=np, options=EXACT):
+        y = state["y"] + (x["effort"] - state["y"]) * (1.0 - math.exp(-dt / p["time_constant_s"]))
+        return y, {"y": y}
 
     def _apply_stateful(self, x, p):
         return lowpass(x["effort"], x["time"], p["time_constant_s"])

@@ -16,7 +16,7 @@ from scipy.signal import lfilter, lfilter_zi
 from scipy.special import erf, wrightomega
 
 from seadesign.constants import THESIS_K_MEASURED_NM_PER_RAD
-from seadesign.effects.base import Effect, Param, Scales, Search, lowpass, rows, time_steps
+from seadesign.effects.base import EXACT, Effect, Param, Scales, Search, lowpass, rows, time_steps
 
 
 class DeadBand(Effect):
@@ -33,9 +33,12 @@ class DeadBand(Effect):
     reads = ("deflection",)
     writes = "deflection"
 
-    def _map(self, x, p, rng):
-        d = x["deflection"]
-        return np.sign(d) * np.maximum(np.abs(d) - 0.5 * p["width_rad"], 0.0)
+    def _map(self, x, p, rng, xp=np, options=EXACT):
+        d, half, s = x["deflection"], 0.5 * p["width_rad"], options.dead_zone_smoothing_rad
+        if s is None:
+            return xp.sign(d) * xp.maximum(xp.abs(d) - half, 0.0)
+        softplus = options.softplus or (lambda z: xp.logaddexp(xp.zeros_like(z), z))
+        return s * (softplus((d - half) / s) - softplus((-d - half) / s))
 
     @staticmethod
     def free_travel(spring_deflection: np.ndarray, width_rad: float, noise_rad: float = 0.0) -> np.ndarray:
@@ -62,7 +65,7 @@ class LinearSpring(Effect):
     reads = ("deflection",)
     writes = "torque"
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
         return x["torque"] + p["k_Nm_per_rad"] * x["deflection"]
 
 
@@ -75,8 +78,9 @@ class StiffnessScale(Effect):
     parameters = (Param("scale", "1", 1.0, 0.01, 100.0, "ratio of true to modelled stiffness"),)
     writes = "torque"
     log_params = ("scale",)
+    batch_params = ("scale",)
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
         return p["scale"] * x["torque"]
 
     def search(self, s: Scales) -> Search:
@@ -110,7 +114,7 @@ class CubicStiffening(Effect):
     reads = ("deflection",)
     writes = "torque"
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
         return x["torque"] + p["k3_Nm_per_rad3"] * x["deflection"] ** 3
 
     def search(self, s: Scales) -> Search:
@@ -191,17 +195,16 @@ class DahlHysteresis(Effect):
     stateful = True
     log_params = ("torque_Nm", "stiffness_Nm_per_rad")
 
-    def _init(self, x, p):
-        return {"z": np.zeros_like(x["deflection"]), "d": x["deflection"].copy()}
+    def _init(self, x, p, xp=np):
+        return {"z": xp.zeros_like(x["deflection"]), "d": x["deflection"]}
 
-    def _advance(self, state, x, dt, p):
+    def _advance(self, state, x, dt, p, xp=np, options=EXACT):
         d = x["deflection"]
         step = d - state["d"]
         th = p["torque_Nm"]
-        s = np.sign(step)
-        state["z"] = s * th + (state["z"] - s * th) * np.exp(-p["stiffness_Nm_per_rad"] * np.abs(step) / th)
-        state["d"] = d.copy()
-        return x["torque"] + state["z"]
+        s = xp.sign(step)
+        z = s * th + (state["z"] - s * th) * xp.exp(-p["stiffness_Nm_per_rad"] * xp.abs(step) / th)
+        return x["torque"] + z, {"z": z, "d": d}
 
     def _apply_stateful(self, x, p):
         d, torque = np.broadcast_arrays(x["deflection"], x["torque"])
@@ -245,13 +248,13 @@ class Viscoelastic(Effect):
     stateful = True
     log_params = ("relaxation_time_s",)
 
-    def _init(self, x, p):
-        return {"relaxed": x["deflection"].copy()}
+    def _init(self, x, p, xp=np):
+        return {"relaxed": x["deflection"]}
 
-    def _advance(self, state, x, dt, p):
+    def _advance(self, state, x, dt, p, xp=np, options=EXACT):
         d = x["deflection"]
-        state["relaxed"] = state["relaxed"] + (d - state["relaxed"]) * (1.0 - math.exp(-dt / p["relaxation_time_s"]))
-        return x["torque"] + p["maxwell_stiffness_Nm_per_rad"] * (d - state["relaxed"])
+        relaxed = state["relaxed"] + (d - state["relaxed"]) * (1.0 - math.exp(-dt / p["relaxation_time_s"]))
+        return x["torque"] + p["maxwell_stiffness_Nm_per_rad"] * (d - relaxed), {"relaxed": relaxed}
 
     def _apply_stateful(self, x, p):
         relaxed = lowpass(x["deflection"], x["time"], p["relaxation_time_s"])
@@ -329,17 +332,15 @@ class ThermalSoftening(Effect):
     stateful = True
     log_params = ("cooling_time_s",)
 
-    def _init(self, x, p):
-        return {"heat": np.zeros_like(x["deflection"]), "d": x["deflection"].copy()}
+    def _init(self, x, p, xp=np):
+        return {"heat": xp.zeros_like(x["deflection"]), "d": x["deflection"]}
 
-    def _advance(self, state, x, dt, p):
+    def _advance(self, state, x, dt, p, xp=np, options=EXACT):
         d, tau, c = x["deflection"], x["torque"], p["softening_per_J"]
         kept = state["heat"] * math.exp(-dt / p["cooling_time_s"])
-        work = np.abs(tau * (d - state["d"]))
-        f = np.maximum((1.0 - c * kept) / (1.0 + c * work), 0.05)
-        state["heat"] = kept + f * work
-        state["d"] = d.copy()
-        return tau * f
+        work = xp.abs(tau * (d - state["d"]))
+        f = xp.maximum((1.0 - c * kept) / (1.0 + c * work), 0.05)
+        return tau * f, {"heat": kept + f * work, "d": d}
 
     def _apply_stateful(self, x, p):
         c, tc = p["softening_per_J"], p["cooling_time_s"]
@@ -375,9 +376,9 @@ class TemperatureSoftening(Effect):
     reads = ("temperature",)
     writes = "torque"
 
-    def _map(self, x, p, rng):
+    def _map(self, x, p, rng, xp=np, options=EXACT):
         factor = 1.0 - p["softening_per_K"] * (x["temperature"] - p["reference_temperature_C"])
-        return x["torque"] * np.maximum(factor, 0.05)
+        return x["torque"] * xp.maximum(factor, 0.05)
 
     def search(self, s: Scales) -> Search:
         t0 = s.temperature_C  # held at the first sample's temperature: T0 and a stiffness scale are one freedom
