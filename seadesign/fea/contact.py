@@ -31,15 +31,16 @@ NEAR_COSINE = 0.5
 @dataclass(frozen=True)
 class ContactSettings:
     """Frictionless contact by an augmented Lagrangian: penalty stiffness `penalty_factor` times the law's
-    shear modulus over the mean boundary edge length (Pa/m), multipliers updated until the largest
-    penetration is below `penetration_tol_mm`, at most `max_augmentations` times an increment.
+    shear modulus over the mean boundary edge length (Pa/m), multipliers updated until no pair under pressure
+    penetrates, or is held open by its multiplier, by more than `penetration_tol_mm` (`FrictionlessContact.gap_error_m`),
+    at most `max_augmentations` times an increment.
 
     The tangent (`FrictionlessContact.tangent_blocks`) is the exact second derivative of the contact energy: the
     normal stiffness w eps grad g grad g and the pressure's geometric part - w t hess g, without which Newton
     converges only linearly once the contact carries load."""
 
     penalty_factor: float = 100.0
-    penetration_tol_mm: float = 0.0045  # 1 % of the default study's 0.45 mm fillet radius
+    penetration_tol_mm: float = 0.0045  # 1 % of the default study's 0.45 mm fillet radius; bounds `gap_error_m`
     max_augmentations: int = 30
     search_mm: float = 0.1  # beyond a facet's reach (its largest centroid-to-corner distance), how far from its
     # centroid a point is paired with it: more than any gap that can carry pressure; and how far behind its plane:
@@ -351,11 +352,14 @@ class FrictionlessContact:
             return 1.0
         return float(np.clip(g0[closing] / (g0[closing] - g1[closing]), 0.0, 1.0).min())
 
-    def penetration_m(self, u: np.ndarray, assignment: tuple[np.ndarray, np.ndarray] | None = None) -> float:
-        """The largest penetration (m) of a point under pressure at u, 0 without one (pairs as in `pairs`)."""
+    def gap_error_m(self, u: np.ndarray, assignment: tuple[np.ndarray, np.ndarray] | None = None) -> float:
+        """The largest |gap| (m) of a pair under pressure at u, 0 without one (pairs as in `pairs`): its penetration,
+        or the open gap that its multiplier still presses across (a pressure max(0, lam - eps g) > 0 at g > 0, where
+        surfaces part). Frictionless contact wants gap and pressure complementary (g >= 0, p >= 0, p g = 0); the
+        augmented Lagrangian has converged when this is within the tolerance."""
         pairs = self.pairs(u, assignment)
         pressed = self.pressure_Pa(pairs) > 0
-        return float(max(0.0, -pairs.gap_m[pressed].min())) if pressed.any() else 0.0
+        return float(np.abs(pairs.gap_m[pressed]).max()) if pressed.any() else 0.0
 
     def _variables(self, u: np.ndarray, pairs: ContactPairs, which: np.ndarray) -> tuple[tuple[np.ndarray, ...], np.ndarray]:
         c = pairs.coefficients[which]

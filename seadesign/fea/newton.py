@@ -21,20 +21,21 @@ class NewtonSettings:
 class NewtonResult:
     """The last iterate u (m), its internal forces (N; None when they could not be evaluated), the residual
     norms (N) of the iterations and the status: "converged", "unstable" (a tangent that is not positive
-    definite), "failed", or "penetrating" (equilibrium, but contact the multiplier updates could not bring
-    within its penetration tolerance; `penetration_m` says how far)."""
+    definite), "failed", or "penetrating" (equilibrium, but contact the multiplier updates could not bring within
+    its tolerance: a pair penetrating, or pressed across an open gap; `gap_error_m` says how far)."""
 
     u: np.ndarray
     forces: np.ndarray | None
     residual_norms: list[float]
     status: str
-    penetration_m: float = 0.0
+    gap_error_m: float = 0.0
     augmentations: int = 0
 
 
 def newton_augmented(system: Equilibrium, u0: np.ndarray, settings: NewtonSettings = NewtonSettings()) -> NewtonResult:
     """`newton` with the contact pairs searched at u0 and held (the contact search once an increment); then, while
-    the solution penetrates further than the contact's tolerance, Uzawa's update of the contact multipliers and
+    a pair under pressure penetrates, or is held open by its multiplier, further than the contact's tolerance
+    (`FrictionlessContact.gap_error_m`), Uzawa's update of the contact multipliers and
     `newton` again: the augmented Lagrangian. Penetration is also measured on the pairs searched afresh at the
     solution; where those penetrate beyond the tolerance (a point the held pairs missed), they join the held ones
     (which stay: a point that slid out of its facet's prism keeps its plane until the next increment, so that
@@ -50,10 +51,10 @@ def newton_augmented(system: Equilibrium, u0: np.ndarray, settings: NewtonSettin
     norms, tol = list(result.residual_norms), contact.settings.penetration_tol_mm * 1e-3
     for k in range(contact.settings.max_augmentations + 1):
         fresh = contact.search(result.u)
-        missed = contact.penetration_m(result.u, contact.new_pairs(fresh)) > tol
+        missed = contact.gap_error_m(result.u, contact.new_pairs(fresh)) > tol
         if missed:
             contact.assignment = contact.with_pairs(fresh)
-        depth = contact.penetration_m(result.u)
+        depth = contact.gap_error_m(result.u)
         if depth <= tol:
             return NewtonResult(result.u, result.forces, norms, "converged", depth, k)
         if k == contact.settings.max_augmentations:
