@@ -250,19 +250,20 @@ def rotation_sweep(mesh: TetMesh, law: Hyperelastic, rotations_rad: list[float],
     unloading, any sequence. Each is reached from the last point as the path reaches its next increment (the same
     predictor and, through contact, the multipliers extrapolated from the last two points), an interval that does
     not converge halved down to `settings.min_step_rad` (then SolverError, naming the rotation); no events, no
-    stops. A frictionless elastic part is reversible: unloading retraces loading (tested through contact). Rest is
-    the start: a rotation of 0 has no reaction to judge convergence against, and is refused."""
+    stops. The points: rest, then one per given rotation (those a halved interval inserts are left out). A
+    frictionless elastic part is reversible: unloading retraces loading (tested through contact). Rest is the start:
+    a rotation of 0 has no reaction to judge convergence against, and is refused."""
     if not all(rotations_rad):
         raise SolverError("rotation_sweep starts at rest: give non-zero rotations (rad)")
     p = path_problem(mesh, law, settings, order)
     u = np.zeros_like(p.solid.mesh.nodes_m)
     try:
         point, v = _state(p, u, np.zeros_like(u), 0.0, 0, [0.0])
-        points, previous = [point], None
+        points, last, previous = [point], point, None
         held = held_before = None if p.system.contact is None else p.system.contact.multipliers
-        pending = list(rotations_rad)[::-1]
+        pending = [(theta, True) for theta in rotations_rad[::-1]]  # (rotation, given), the next one last
         while pending:
-            theta, last = pending[-1], points[-1]
+            theta, given = pending[-1]
             step = theta - last.rotation_rad
             guess = _predict(p, u, v, step, previous, last.rotation_rad)
             guess[p.drive.hub] = p.drive.displacement(theta)
@@ -271,14 +272,15 @@ def rotation_sweep(mesh: TetMesh, law: Hyperelastic, rotations_rad: list[float],
                 if abs(step) / 2 < settings.min_step_rad:
                     raise SolverError(f"no equilibrium at the hub rotation {theta:.6g} rad: Newton {solved.status} from "
                                       f"{last.rotation_rad:.6g} rad with the smallest step")
-                pending.append(last.rotation_rad + step / 2)
+                pending.append((last.rotation_rad + step / 2, False))
                 continue
             point, v_new = _state(p, solved.u, solved.forces, theta, len(solved.residual_norms) - 1,
                                   solved.residual_norms)
             if p.system.contact is not None:
                 held_before, held = held, p.system.contact.multipliers
-            points.append(point)
-            previous, u, v = (u, last.rotation_rad), solved.u, v_new
+            if given:
+                points.append(point)
+            previous, u, v, last = (u, last.rotation_rad), solved.u, v_new, point
             pending.pop()
     finally:
         p.system.close()
