@@ -244,8 +244,8 @@ def _predict(p: PathProblem, u: np.ndarray, v: np.ndarray, step: float,
     return u + swirl + rest * step
 
 
-def rotation_sweep(mesh: TetMesh, law: Hyperelastic, rotations_rad: list[float], settings: PathSettings = PathSettings(),
-                   order: int = 2) -> tuple[PathPoint, ...]:
+def rotation_sweep(mesh: TetMesh, law: Hyperelastic, rotations_rad: list[float],
+                   settings: PathSettings = PathSettings(), order: int = 2) -> tuple[PathPoint, ...]:
     """The equilibria at the hub rotations `rotations_rad` (rad) in the order given, from rest: loading, then
     unloading, any sequence. Each is reached from the last point as the path reaches its next increment (the same
     predictor and, through contact, the multipliers extrapolated from the last two points), an interval that does
@@ -270,8 +270,8 @@ def rotation_sweep(mesh: TetMesh, law: Hyperelastic, rotations_rad: list[float],
             solved = _solve(p, guess, held, held_before, step / (last.rotation_rad - previous[1]) if previous else 0.0)
             if solved.status != "converged":
                 if abs(step) / 2 < settings.min_step_rad:
-                    raise SolverError(f"no equilibrium at the hub rotation {theta:.6g} rad: Newton {solved.status} from "
-                                      f"{last.rotation_rad:.6g} rad with the smallest step")
+                    raise SolverError(f"no equilibrium at the hub rotation {theta:.6g} rad: Newton {solved.status} "
+                                      f"from {last.rotation_rad:.6g} rad with the smallest step")
                 pending.append((last.rotation_rad + step / 2, False))
                 continue
             point, v_new = _state(p, solved.u, solved.forces, theta, len(solved.residual_norms) - 1,

@@ -4,8 +4,9 @@
 parameter from them: the servo (P gain, torque limit, no-load speed, stall torque), the link (inertia),
 the substep count, and each enabled effect's values and signal bindings. Each effect steps through its one
 definition (`Effect.advance`, written against an array namespace) on torch tensors (`array_api_compat`); an
-effect that writes or reads a signal the knee does not have at its stage is refused by name. The model is the one `KneeSession` documents, per knee and in the
-flexion frame (left-knee sign; `to_robot` mirrors the right knee):
+effect that writes or reads a signal the knee does not have at its stage is refused by name. The model is the
+one `KneeSession` documents, per knee and in the flexion frame (left-knee sign; `to_robot` mirrors the right
+knee):
 
 - servo: u = clamp(Kp (command - qm), +-limit), qm' = clamp(w0 (u - spring torque) / stall, +-w0);
 - torque path: deflection qm - angle through the `deflection` effects, the spring (k or the large-deflection
@@ -277,7 +278,8 @@ class TorchKnee:
 
     def _sense(self) -> TorchObservation:
         state = self._state
-        sig: Sig = {"time": torch.full_like(state.motor_rad, state.sample * self.dt), "hall": state.angle_rad, "motor": state.motor_rad,
+        sig: Sig = {"time": torch.full_like(state.motor_rad, state.sample * self.dt), "hall": state.angle_rad,
+                    "motor": state.motor_rad,
                     "effort": state.spring_torque_Nm, "motor_velocity": state.motor_velocity_rad_per_s}
         states = dict(state.effects)
         for target in SENSORS:
