@@ -164,9 +164,7 @@ def rotation_path(
             last = points[-1]
             step = min(step, settings.max_step_rad, settings.max_rotation_rad - last.rotation_rad)
             theta = last.rotation_rad + step
-            guess = _predict(p, u, v, step, previous, last.rotation_rad)
-            guess[p.drive.hub] = p.drive.displacement(theta)
-            solved = _solve(p, guess, held, held_before, step / (last.rotation_rad - previous[1]) if previous else 0.0)
+            solved = _solve(p, u, v, previous, last.rotation_rad, step, theta, held, held_before)
             trial, forces, norms, status = solved.u, solved.forces, solved.residual_norms, solved.status
             event = None
             if status == "converged":
@@ -214,14 +212,17 @@ def rotation_path(
                       time.perf_counter() - t0, index, shot, tuple(events))
 
 
-def _solve(p: PathProblem, guess: np.ndarray, held: Multipliers | None, held_before: Multipliers | None,
-           ratio: float) -> NewtonResult:
-    """Newton from the guess; with contact, the augmented Lagrangian from the multipliers extrapolated linearly
-    from the last two converged points' (`held`, `held_before`; `ratio`: the step over the last one), so that every
-    attempt, a cut-back's too, starts from the converged ones."""
+def _solve(p: PathProblem, u: np.ndarray, v: np.ndarray, previous: tuple[np.ndarray, float] | None, last_rad: float,
+           step: float, theta: float, held: Multipliers | None, held_before: Multipliers | None) -> NewtonResult:
+    """Newton at the hub rotation theta (rad), `step` on from the last point (u, its direction v, at `last_rad`;
+    `previous`: the point before it), from `_predict`'s guess; with contact, the augmented Lagrangian from the multipliers extrapolated
+    linearly from the last two converged points' (`held`, `held_before`), so that every attempt, a cut-back's too,
+    starts from the converged ones."""
+    guess = _predict(p, u, v, step, previous, last_rad)
+    guess[p.drive.hub] = p.drive.displacement(theta)
     if p.system.contact is None:
         return newton(p.system, guess, p.settings.newton)
-    p.system.contact.multipliers = held.extrapolated(held_before, ratio)
+    p.system.contact.multipliers = held.extrapolated(held_before, step / (last_rad - previous[1]) if previous else 0.0)
     return newton_augmented(p.system, guess, p.settings.newton)
 
 
@@ -265,9 +266,7 @@ def rotation_sweep(mesh: TetMesh, law: Hyperelastic, rotations_rad: list[float],
         while pending:
             theta, given = pending[-1]
             step = theta - last.rotation_rad
-            guess = _predict(p, u, v, step, previous, last.rotation_rad)
-            guess[p.drive.hub] = p.drive.displacement(theta)
-            solved = _solve(p, guess, held, held_before, step / (last.rotation_rad - previous[1]) if previous else 0.0)
+            solved = _solve(p, u, v, previous, last.rotation_rad, step, theta, held, held_before)
             if solved.status != "converged":
                 if abs(step) / 2 < settings.min_step_rad:
                     raise SolverError(f"no equilibrium at the hub rotation {theta:.6g} rad: Newton {solved.status} "
