@@ -92,6 +92,8 @@ def test_patch_a_block_pressed_on_a_rigid_face_takes_the_uniform_pressure(base_c
     assert np.abs(force[:, :2]).max() < 1e-12 * load.max()  # frictionless: no tangential force at all
     assert np.abs(result.u[top] - exact[top]).max() < 2e-7 * SQUEEZE_MM * MM  # measured 3.7e-8 to 4.8e-8
     assert system.contact.summary(result.u).area_m2 == pytest.approx(MM**2, rel=1e-12)  # the 1 x 1 mm footprint
+    # the pairs' normal force: the closed-form pressure on the footprint (measured 7e-11 to 3.0e-10)
+    assert system.contact.normal_force_N(result.u) == pytest.approx(pressure * MM**2, rel=1e-9)
 
 
 def test_a_deformable_base_carries_the_same_total_load():

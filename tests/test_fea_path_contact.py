@@ -113,3 +113,19 @@ def test_unloading_retraces_loading(candidate):
         assert down.torque_Nm == pytest.approx(load.torque_Nm, rel=bound)
     with pytest.raises(SolverError, match="non-zero"):
         rotation_sweep(mesh, law, [0.1, 0.0])
+
+
+@pytest.mark.slow
+def test_an_increment_that_loses_energy_at_every_step_ends_the_path_saying_where(candidate, monkeypatch):
+    # the balance made to fail past 0.35 rad (as where a fold loses energy at every step size): the increments past
+    # it are cut back to the smallest step, none is kept, and the path ends unconverged with the event there
+    import seadesign.fea.rotation_path as rp
+
+    balanced = rp.energy_balanced
+    monkeypatch.setattr(rp, "energy_balanced", lambda a, b, *energies: b.rotation_rad <= 0.35 and balanced(a, b, *energies))
+    path = _path(candidate, min_step_rad=0.002)
+    assert path.stop_reason == "unconverged" and path.points[-1].rotation_rad <= 0.35
+    assert path.points[-1].rotation_rad > 0.35 - 0.004  # cut back until the step is below the smallest
+    event = path.events[-1]
+    assert event.kind == "contact_energy_loss" and 0.35 < event.rotation_rad < 0.35 + 0.004
+    assert math.isnan(event.torque_Nm) and np.isfinite(event.at_mm).all()

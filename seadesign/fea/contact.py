@@ -316,6 +316,11 @@ class FrictionlessContact:
             blocks[a] = k
         return pairs.nodes, blocks
 
+    def normal_force_N(self, u: np.ndarray) -> float:
+        """The sum of the pairs' normal forces at u (N): pressure times rest weight."""
+        pairs = self.pairs(u)
+        return float(self.surface.weights_m2[pairs.point] @ self.pressure_Pa(pairs))
+
     def summary(self, u: np.ndarray) -> ContactSummary:
         """The contact at u: area under pressure, its peak and where, the pairs' moment about z, the penetration."""
         pairs = self.pairs(u)

@@ -74,3 +74,19 @@ def stop_point(points: list[PathPoint], reason: str, target_Nm: float, gap_mm: f
         s = float(np.clip((a.min_gap_mm - gap_mm) / (a.min_gap_mm - b.min_gap_mm), 0.0, 1.0))
         return a.rotation_rad + s * (b.rotation_rad - a.rotation_rad), float(hermite(a, b, s))
     return last.rotation_rad, last.torque_Nm
+
+
+
+def energy_balanced(a: PathPoint, b: PathPoint, energy_a_J: float, energy_b_J: float, contact_work_J: float) -> bool:
+    """Whether the hub's work from a to b equals the strain energy's increase from `energy_a_J` to `energy_b_J`
+    (J), as frictionless contact asks (it stores no energy of its own). The work is the integral of the cubic
+    Hermite curve through the two points; allowed: 4 times that quadrature's error scale (its difference from
+    the trapezoid, h^2 / 12 |T'a - T'b|, Nm rad), the work the contact forces may do within the penetration
+    tolerance (`contact_work_J`: the normal forces at a and b times the tolerance) and 1e-6 of the energy at b
+    (Newton's tolerance). A curve whose tangent jumps inside the step (contact onset) passes at any step (the
+    rule's error there is at most |kink|); energy lost in a jump fails once the steps are small, the shape's
+    allowance shrinking as h^2."""
+    h = b.rotation_rad - a.rotation_rad
+    kink = h * h / 12 * (a.tangent_Nm_per_rad - b.tangent_Nm_per_rad)
+    work = h / 2 * (a.torque_Nm + b.torque_Nm) + kink
+    return abs(work - (energy_b_J - energy_a_J)) <= 4 * abs(kink) + contact_work_J + 1e-6 * abs(energy_b_J)

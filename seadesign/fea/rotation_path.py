@@ -23,7 +23,10 @@ The path stops, and says why (`STOP_REASONS` of `design.spring`):
   the first pressed pair's gap closes), each point records the contact's area, peak pressure, moment
   and penetration, and an increment whose penetration the multiplier updates cannot bring within
   the tolerance is cut back like one that does not converge (below `min_step_rad` the path ends
-  unconverged, and an "unresolved_penetration" event says where);
+  unconverged, and an "unresolved_penetration" event says where); so is an increment over which the
+  hub's work and the strain energy's increase differ (`path_events.energy_balanced`: frictionless
+  contact stores no energy), and where that holds at every step size a "contact_energy_loss" event
+  says where;
 - strain_limit: the peak tensile principal engineering strain passed the allowable strain;
 - rotation_limit: the rotation reached `max_rotation_rad` below the target torque;
 - unconverged: the increment fell below `min_step_rad` without convergence (never a capacity).
@@ -46,7 +49,8 @@ from seadesign.fea.equilibrium import Equilibrium
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.hub_rotation import HubRotation, moment_z
 from seadesign.fea.newton import NewtonResult, NewtonSettings, newton, newton_augmented
-from seadesign.fea.path_events import bracketing_step, contact_event, contact_rotation, stop_check, stop_point
+from seadesign.fea.path_events import (bracketing_step, contact_event, contact_rotation, energy_balanced, stop_check,
+                                       stop_point)
 from seadesign.fea.torque_path import PathEvent, PathPoint, TorquePath
 from seadesign.fea.torsion import MM, surface_nodes
 from seadesign.mesh.tetmesh import TetMesh
@@ -73,8 +77,8 @@ class PathSettings:
 
 def through_contact(settings: PathSettings) -> PathSettings:
     """`settings` with frictionless self-contact, and 60 Newton iterations an attempt: a creasing notch's active set
-    takes that many to settle (on the 3 x 8 mm candidate's coarse mesh 30 reached 0.558 rad in 104 s and ended
-    unconverged, 60 reached 0.6 rad in 62 s)."""
+    takes that many to settle (on the 3 x 8 mm candidate's coarse mesh, before the energy balance, 30 ended the
+    path unconverged at 0.558 rad after 104 s and 60 reached 0.6 rad in 62 s)."""
     return replace(settings, contact=ContactSettings(), newton=replace(settings.newton, max_iterations=60))
 
 
@@ -160,6 +164,7 @@ def rotation_path(
         events: list[PathEvent] = []
         held = None if p.system.contact is None else p.system.contact.multipliers  # the last point's multipliers
         held_before = held  # the point's before it
+        balance = (0.0, 0.0)  # the last point's strain energy (J) and contact normal force (N): `energy_balanced`
         while reason is None:
             last = points[-1]
             step = min(step, settings.max_step_rad, settings.max_rotation_rad - last.rotation_rad)
@@ -173,6 +178,11 @@ def rotation_path(
                     event = stop_check(settings, last, point, target_torque_Nm)
                 except NotPositiveDefinite:
                     status = "unstable"
+                if status == "converged" and p.system.contact is not None:
+                    trial_balance = (p.solid.energy(trial), p.system.contact.normal_force_N(trial))
+                    contact_work = (balance[1] + trial_balance[1]) * settings.contact.penetration_tol_mm * 1e-3
+                    if not energy_balanced(last, point, balance[0], trial_balance[0], contact_work):
+                        status = "losing_energy"
             located = step <= (settings.contact_locate_tol_rad if event == "contact" else settings.locate_tol_rad)
             if status == "unstable" and located:
                 reason = "bifurcation"
@@ -185,15 +195,16 @@ def rotation_path(
                     contact = next((c for c in estimates if c is not None and last.rotation_rad < c < theta), None)
                     probe = point
                 step = step * 0.5 if contact is None else bracketing_step(contact, last.rotation_rad, settings)
-                if status in ("failed", "penetrating") and step < settings.min_step_rad:
+                if status in ("failed", "penetrating", "losing_energy") and step < settings.min_step_rad:
                     reason = "unconverged"
-                    if status == "penetrating":  # where: the rotation tried, where the contact presses hardest
-                        events.append(PathEvent("unresolved_penetration", theta, float("nan"),
-                                                p.system.contact.summary(trial).peak_at_mm))
+                    if status != "failed":  # where: the rotation tried, where the contact presses hardest
+                        kind = "unresolved_penetration" if status == "penetrating" else "contact_energy_loss"
+                        events.append(PathEvent(kind, theta, float("nan"), p.system.contact.summary(trial).peak_at_mm))
             else:
                 if p.system.contact is not None and not events and point.contact.area_m2 > 0:
                     events.append(contact_event(last, point, p.system.contact.closing_fraction(u, trial)))
                 held_before, held = held, None if p.system.contact is None else p.system.contact.multipliers
+                balance = trial_balance if p.system.contact is not None else balance
                 points.append(point)
                 if snapshot is None and snapshot_torque_Nm is not None and point.torque_Nm >= snapshot_torque_Nm:
                     snapshot = (len(points) - 1, trial)
