@@ -76,7 +76,6 @@ def stop_point(points: list[PathPoint], reason: str, target_Nm: float, gap_mm: f
     return last.rotation_rad, last.torque_Nm
 
 
-
 def energy_balanced(a: PathPoint, b: PathPoint, energy_a_J: float, energy_b_J: float, contact_work_J: float) -> bool:
     """Whether the hub's work from a to b equals the strain energy's increase from `energy_a_J` to `energy_b_J`
     (J), as frictionless contact asks (it stores no energy of its own). The work is the integral of the cubic
