@@ -116,16 +116,27 @@ def test_unloading_retraces_loading(candidate):
 
 
 @pytest.mark.slow
-def test_an_increment_that_loses_energy_at_every_step_ends_the_path_saying_where(candidate, monkeypatch):
-    # the balance made to fail past 0.35 rad (as where a fold loses energy at every step size): the increments past
-    # it are cut back to the smallest step, none is kept, and the path ends unconverged with the event there
+@pytest.mark.parametrize("failure", ["contact_energy_loss", "contact_unconverged"])
+def test_an_increment_that_fails_at_every_step_ends_the_path_saying_where(candidate, monkeypatch, failure):
+    # past 0.35 rad every attempt made to fail (as where a fold loses energy, or Newton wanders in a crease, at every
+    # step size): the increments past it are cut back to the smallest step, none is kept, and the path ends
+    # unconverged with the event there
+    from dataclasses import replace
+
     import seadesign.fea.rotation_path as rp
 
-    balanced = rp.energy_balanced
-    monkeypatch.setattr(rp, "energy_balanced", lambda a, b, *energies: b.rotation_rad <= 0.35 and balanced(a, b, *energies))
+    if failure == "contact_energy_loss":
+        balanced = rp.energy_balanced
+        monkeypatch.setattr(rp, "energy_balanced",
+                            lambda a, b, *energies: b.rotation_rad <= 0.35 and balanced(a, b, *energies))
+    else:
+        solve = rp._solve
+        monkeypatch.setattr(rp, "_solve", lambda p, u, v, previous, last, step, theta, *held: (
+            lambda r: r if theta <= 0.35 else replace(r, status="failed"))(solve(p, u, v, previous, last, step, theta,
+                                                                                 *held)))
     path = _path(candidate, min_step_rad=0.002)
     assert path.stop_reason == "unconverged" and path.points[-1].rotation_rad <= 0.35
     assert path.points[-1].rotation_rad > 0.35 - 0.004  # cut back until the step is below the smallest
     event = path.events[-1]
-    assert event.kind == "contact_energy_loss" and 0.35 < event.rotation_rad < 0.35 + 0.004
+    assert event.kind == failure and 0.35 < event.rotation_rad < 0.35 + 0.004
     assert math.isnan(event.torque_Nm) and np.isfinite(event.at_mm).all()

@@ -15,6 +15,8 @@ from seadesign.fea.pardiso import Pardiso
 class NewtonSettings:
     max_iterations: int = 30
     refresh_ratio: float = 0.5  # refactor the tangent when an iteration cuts the residual by less than this
+    stall_window: int | None = None  # give up ("failed") when the residual has not halved over this many
+    # iterations (`stalled`); None: only `max_iterations` ends a solve
 
 
 @dataclass(frozen=True)
@@ -90,6 +92,8 @@ def newton(system: Equilibrium, u0: np.ndarray, settings: NewtonSettings = Newto
         norms.append(float(np.linalg.norm(r)))
         if system.converged(f, norms[-1]):
             return NewtonResult(u, f, norms, "converged")
+        if stalled(norms, settings.stall_window):
+            return NewtonResult(u, f, norms, "failed")
         if refresh and not fresh:
             try:
                 system.factor(u)
@@ -113,6 +117,12 @@ def newton(system: Equilibrium, u0: np.ndarray, settings: NewtonSettings = Newto
         u, f, r, fresh = trial, f1, r1, False
     norms.append(float(np.linalg.norm(r)))
     return NewtonResult(u, f, norms, "converged" if system.converged(f, norms[-1]) else "failed")
+
+
+def stalled(norms: list[float], window: int | None) -> bool:
+    """Whether the last residual norm is above half the one `window` iterations before (None: never): Newton
+    wandering, as where a creasing notch makes the tangent indefinite, rather than converging, if only linearly."""
+    return window is not None and len(norms) > window and norms[-1] > 0.5 * norms[-1 - window]
 
 
 def _bfgs_solve(factorization: Pardiso, r: np.ndarray, updates: list[tuple[np.ndarray, np.ndarray, float]]) -> np.ndarray:

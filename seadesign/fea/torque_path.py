@@ -36,7 +36,8 @@ class PathEvent:
     """Something on the path: its kind ("contact": facing surfaces first carry pressure; "unresolved_penetration":
     the multiplier updates could not bring the penetration within the tolerance, so the path ended unconverged,
     torque NaN; "contact_energy_loss": likewise, the hub's work and the strain energy's increase differing at every
-    step size), rotation (rad), torque (Nm) and where (mm, the part at rest)."""
+    step size; "contact_unconverged": likewise, Newton finding no equilibrium in contact), rotation (rad), torque (Nm)
+    and where (mm, the part at rest)."""
 
     kind: str
     rotation_rad: float
