@@ -89,6 +89,21 @@ def test_through_contact_the_event_names_first_contact_and_the_loads_their_share
         assert point.contact_share == pytest.approx(2 * (_theta(torque) - 0.3) / torque, rel=1e-3)
 
 
+@pytest.mark.parametrize("kind", ["contact_unconverged", "unresolved_penetration", "contact_energy_loss"])
+def test_a_path_that_contact_ends_unconverged_says_why_and_where(kind):
+    # the curve ends unconverged at 0.6 rad (11.6 Nm, short of the stall torque) after contact at 0.3 rad; the
+    # increment tried to 0.61 rad failed where the event says
+    events = (PathEvent("contact", 0.3, A * math.tanh(0.3 / B), (1.0, 2.0, 3.0)),
+              PathEvent(kind, 0.61, math.nan, (4.0, 5.0, 6.0)))
+    ld = large_deflection(replace(_path(0.6, "unconverged"), events=events), 2.0, 11.7, 14.0, LIMITS)
+    assert ld.stop_reason == "unconverged" and not ld.stall.reached and not ld.stall.survives
+    assert ld.unconverged_cause == kind and ld.unconverged_rotation_rad == 0.61
+    assert (ld.unconverged_at.x_mm, ld.unconverged_at.y_mm, ld.unconverged_at.z_mm) == (4.0, 5.0, 6.0)
+    plain = large_deflection(replace(_path(0.6, "unconverged"), events=events[:1]), 2.0, 11.7, 14.0, LIMITS)
+    assert plain.unconverged_cause == "" and math.isnan(plain.unconverged_rotation_rad)  # Newton failed before contact
+    assert math.isnan(plain.unconverged_at.x_mm)
+
+
 def test_columns_keep_words_flags_and_curves():
     ld = large_deflection(_path(0.5, "contact", n=3), 2.0, 11.7, 14.0, StrainLimits(None, None))
     c = columns(ld, "large_")

@@ -198,3 +198,21 @@ def test_the_standing_verdict_says_where_a_path_ends_below_the_standing_torque()
         "the standing load")
     assert standing_verdict(ranked, "long", study).endswith("standing deflection 4 deg under 2.07 Nm (limit 10 deg): "
                                                             "carries the standing load")
+
+
+def test_what_would_unblock_a_design_says_where_contact_ended_its_path():
+    import pandas as pd
+
+    from seadesign.design.study import load_study
+    from seadesign.sweep.rank import unblock
+
+    study = load_study()
+    row = pd.Series({"stall_travel_margin": -0.5, "impact_travel_margin": -0.7, "large_stop_reason": "unconverged",
+                     "large_unconverged_cause": "contact_unconverged", "large_unconverged_rotation_rad": 0.4235,
+                     "large_unconverged_at_x_mm": 1.86, "large_unconverged_at_y_mm": 14.04})
+    assert unblock(row, study) == ("What would unblock it: its path ends unconverged in contact before a load "
+                                   "(contact unconverged at 0.4235 rad, at x 1.9, y 14.0 mm): a stiffer material or "
+                                   "a larger envelope.")
+    plain = row.drop(["large_unconverged_cause"]).copy()
+    assert unblock(plain, study) == ("What would unblock it: its path ends in unconverged before a load: a stiffer "
+                                     "material or a larger envelope.")

@@ -24,7 +24,7 @@ import numpy as np
 
 from seadesign.design.materials import StrainLimits
 from seadesign.fea.results import nested, unscaled
-from seadesign.fea.torque_path import PathEvent, TorquePath
+from seadesign.fea.torque_path import UNCONVERGED_EVENTS, PathEvent, TorquePath
 
 
 @dataclass(frozen=True)
@@ -75,6 +75,10 @@ class LargeDeflection:
     contact_at: PeakLocation = nested()  # the closing pair's midpoint at rest, or through contact where the first
     # contact's pressure peaks (NaN: no contact)
     peak_contact_pressure_MPa: float = unscaled()  # the largest contact pressure on the path (0: none carried)
+    unconverged_cause: str = unscaled()  # why contact ended the path unconverged (the event's kind, see
+    # fea.torque_path.PathEvent); "": it did not
+    unconverged_rotation_rad: float = unscaled()  # the rotation tried there (NaN: none)
+    unconverged_at: PeakLocation = nested()  # where the contact pressed hardest there (NaN: none)
     cyclic_strain_limit: float = unscaled()  # NaN: the material has no sourced cyclic strain limit
     single_strain_limit: float = unscaled()  # elongation at yield / safety factor (NaN: not sourced)
     cyclic_limit_rotation_rad: float = unscaled()  # where the tensile strain passes the cyclic limit (NaN: never)
@@ -170,6 +174,7 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
     torque = np.array([p.torque_Nm for p in pts])
     tensile = np.array([p.peak_tensile_strain for p in pts])
     first_contact = next((e for e in path.events if e.kind == "contact"), None)
+    end = path.events[-1] if path.events and path.events[-1].kind in UNCONVERGED_EVENTS.values() else None
     if first_contact is None and path.stop_reason == "contact":
         first_contact = PathEvent("contact", path.stop_rotation_rad, path.stop_torque_Nm, pts[-1].min_gap_at_mm)
 
@@ -192,6 +197,9 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
         contact_torque_Nm=first_contact.torque_Nm if first_contact else math.nan,
         contact_at=PeakLocation(*first_contact.at_mm) if first_contact else NOWHERE,
         peak_contact_pressure_MPa=max(p.contact.peak_pressure_Pa for p in pts) * 1e-6,
+        unconverged_cause=end.kind if end else "",
+        unconverged_rotation_rad=end.rotation_rad if end else math.nan,
+        unconverged_at=PeakLocation(*end.at_mm) if end else NOWHERE,
         cyclic_strain_limit=cyclic,
         single_strain_limit=single,
         cyclic_limit_rotation_rad=cyclic_theta,

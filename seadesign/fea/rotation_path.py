@@ -52,14 +52,9 @@ from seadesign.fea.hub_rotation import HubRotation, moment_z
 from seadesign.fea.newton import NewtonResult, NewtonSettings, newton, newton_augmented
 from seadesign.fea.path_events import (bracketing_step, contact_event, contact_rotation, energy_balanced, stop_check,
                                        stop_point)
-from seadesign.fea.torque_path import PathEvent, PathPoint, TorquePath
+from seadesign.fea.torque_path import UNCONVERGED_EVENTS, PathEvent, PathPoint, TorquePath
 from seadesign.fea.torsion import MM, surface_nodes
 from seadesign.mesh.tetmesh import TetMesh
-
-
-# why an attempt in contact failed at the smallest step: the event that ends the path there
-UNCONVERGED_EVENTS = {"failed": "contact_unconverged", "penetrating": "unresolved_penetration",
-                      "losing_energy": "contact_energy_loss"}
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,11 @@ class PathPoint:
     contact: ContactSummary = NO_CONTACT  # the contact's pressure, area and moment (a path through contact)
 
 
+# why an attempt in contact failed at the smallest step (Newton's status): the event that ends the path there
+UNCONVERGED_EVENTS = {"failed": "contact_unconverged", "penetrating": "unresolved_penetration",
+                      "losing_energy": "contact_energy_loss"}
+
+
 @dataclass(frozen=True)
 class PathEvent:
     """Something on the path: its kind ("contact": facing surfaces first carry pressure; "unresolved_penetration":
