@@ -2,6 +2,7 @@
 
 Usage: python benchmarks/path_convergence.py [--study wolfgang_knee] [--candidates 8x4,3x8]
        [--meshes 2,path,1] [--rotations 0.1,0.2,0.3] [--max-step-rad 0.004] [--strain-levels 0.1,0.2,0.3,0.433]
+       [--contact]
 Prints, per candidate and mesh (a number: that coarsening of the study's mesh, 1 being the result mesh;
 "path": the sweep's path mesh, the result mesh's in-plane sizing with SolverSettings.path_layers layers
 through the thickness; the finest last), the degrees of freedom, the torque at each listed rotation (Nm), where and why the path stops
@@ -14,6 +15,12 @@ finest. Contact and strain peaks sit at beam roots (fillets), so they converge m
 at the end the path mesh's largest overestimate of those torques against the finest mesh over every candidate
 and level: the knock-down the sweep applies to the path's strain-limit torques (`sweep.requirements.
 STRAIN_TORQUE_KNOCKDOWN`).
+
+`--contact`: the path goes on through frictionless self-contact (`fea.rotation_path.through_contact`, the sweep's
+setting with `[ranking] self_contact`); each mesh's row then also gives first contact (rad, Nm), why and where contact
+ended the path if it ended unconverged, and at the last listed rotation the peak tensile strain with its distance
+(mm, at rest) from where the contact presses hardest: the strain in the contact zone when that distance is small.
+`--docs` then writes docs/validation/_fragments/path_convergence_contact.md.
 
 `--docs` writes the table against the finest mesh (docs/validation/_fragments/path_convergence.md) and, with
 `--strain-levels`, the torques at each strain level (strain_knockdown.md).
@@ -28,7 +35,7 @@ from record import Table, add_docs_option, machine, write_fragment
 
 from seadesign.design.study import load_study
 from seadesign.fea.large_deflection import large_deflection
-from seadesign.fea.rotation_path import PathSettings, rotation_path
+from seadesign.fea.rotation_path import PathSettings, rotation_path, through_contact
 from seadesign.run.cache import Cache
 from seadesign.sweep.stages import SolverSettings, check_geometry, tetrahedralize
 
@@ -65,9 +72,12 @@ def main() -> None:
                                                            "(for a study with continuous axes)")
     ap.add_argument("--max-step-rad", type=float, default=PathSettings().max_step_rad,
                     help="the path's largest step (rad): smaller steps check that no narrow instability is stepped over")
-    add_docs_option(ap, "path_convergence", "strain_knockdown")
+    ap.add_argument("--contact", action="store_true", help="through frictionless self-contact (the sweep's "
+                    "self_contact setting)")
+    add_docs_option(ap, "path_convergence", "strain_knockdown", "path_convergence_contact")
     args = ap.parse_args()
     settings = PathSettings(max_step_rad=args.max_step_rad)
+    settings = through_contact(settings) if args.contact else settings
     st = load_study(args.study)
     cache = Cache()
     meshes = args.meshes.split(",")
@@ -79,6 +89,10 @@ def main() -> None:
     convergence = Table(["design", "mesh", "dofs", f"T at {' / '.join(f'{r:g}' for r in rotations)} rad (Nm)",
                          "stop (rad, Nm)", "single-event strain limit passed at (Nm)",
                          f"peak tensile strain at {rotations[0]:g} rad", "time (s)"])
+    through = Table(["design", "mesh", "dofs", f"T at {' / '.join(f'{r:g}' for r in rotations)} rad (Nm)",
+                     "first contact (rad, Nm)", "end (why, rad, Nm)",
+                     "contact ended it: why, where (x, y, z mm)",
+                     f"peak tensile strain at {rotations[-1]:g} rad (distance to the contact's peak, mm)"])
     knockdown = Table(["design", f"torque (Nm) at tensile strain {' / '.join(f'{x:g}' for x in levels)}, path mesh",
                        f"mesh {meshes[-1]}", f"path / mesh {meshes[-1]}"])
     specs = [args.study_candidate] if args.study_candidate else args.candidates.split(",")
@@ -109,6 +123,10 @@ def main() -> None:
                          ld.stop_rotation_rad, ld.stop_torque_Nm, ld.single_limit_torque_Nm,
                          strain_at(path, rotations[0]), path.time_s))
             _print_row(rows[-1], rows[0])  # as it comes: a long run leaves its coarse rows
+            if args.contact:
+                through.add(candidate.name, c, f"{ld.dofs:,}", " / ".join(f"{v:.4g}" for v in rows[-1][2]),
+                            *_contact_cells(path, ld, rotations[-1]))
+                print("    " + "; ".join(through.rows[-1][4:]), flush=True)
             if levels:
                 at_levels[c] = [torque_at_strain(path, x) for x in levels]
                 print("    torque (Nm) at tensile strain " + ", ".join(f"{x:g}: {v:.4g}" for x, v in
@@ -132,13 +150,34 @@ def main() -> None:
             f"{n} at {x:g}: {r:.4f}" for n, x, r in ratios))
         print(f"largest path-mesh overestimate: {name} at strain {level:g}: x {worst:.4f}; knock-down on the path's "
               f"strain-limit torques: {min(1.0, 1.0 / worst):.4f}")
-    if args.docs:
+    if args.docs and args.contact:
+        write_fragment("path_convergence_contact", through, f"Study {st.name}; meshes {args.meshes} (path: the "
+                       f"sweep's path mesh, 1: the result mesh); through frictionless self-contact")
+    elif args.docs:
         settings_text = (f"Study {st.name}; meshes {args.meshes} (a number: that coarsening of the study's mesh, 1 the "
                          f"result mesh; path: the sweep's path mesh); largest step {settings.max_step_rad:g} rad")
         write_fragment("path_convergence", convergence, settings_text,
                        f"In brackets: the difference to mesh {meshes[-1]}.")
         if knockdown.rows:
             write_fragment("strain_knockdown", knockdown, settings_text)
+
+
+def _contact_cells(path, ld, theta: float) -> list[str]:
+    """First contact, the end, why and where contact ended it, and the peak tensile strain at `theta` (rad) with its
+    element's distance (mm, at rest) from the peak contact pressure of the nearest point."""
+    where = ld.unconverged_at
+    ended = (f"{ld.unconverged_cause} at {ld.unconverged_rotation_rad:.4f} rad, ({where.x_mm:.2f}, {where.y_mm:.2f}, "
+             f"{where.z_mm:.2f})" if ld.unconverged_cause else "-")
+    thetas = np.array([p.rotation_rad for p in path.points])
+    strain = "not reached"
+    if theta <= thetas[-1]:
+        near = path.points[int(np.argmin(np.abs(thetas - theta)))]
+        at = np.array(path.emesh.nodes_m[path.emesh.elements[near.peak_tensile_element, :4]].mean(axis=0) * 1e3)
+        gap = (f"{np.linalg.norm(at - np.array(near.contact.peak_at_mm)):.2f}" if near.contact.area_m2 > 0
+               else "no contact")
+        strain = f"{strain_at(path, theta):.4g} ({gap})"
+    return [f"{ld.contact_rotation_rad:.4f}, {ld.contact_torque_Nm:.4g}",
+            f"{path.stop_reason}, {ld.stop_rotation_rad:.4f}, {ld.stop_torque_Nm:.4g}", ended, strain]
 
 
 def _cells(row, ref) -> list[str]:
