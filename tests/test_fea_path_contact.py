@@ -6,6 +6,7 @@ own), unloading (a frictionless elastic part retraces its loading curve) and the
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -13,7 +14,7 @@ import pytest
 from seadesign.errors import SolverError
 from seadesign.fea.contact import ContactSettings
 from seadesign.fea.finite_strain import Solid
-from seadesign.fea.rotation_path import PathSettings, rotation_path, rotation_sweep
+from seadesign.fea.rotation_path import PathSettings, rotation_path, rotation_sweep, through_contact
 
 END_RAD = 0.42
 
@@ -31,9 +32,11 @@ def candidate(tmp_path_factory):
 
 
 def _path(candidate, **settings):
+    """The path with the sweep's settings through contact (`through_contact`), `settings` replaced."""
     mesh, law = candidate
     contact = settings.pop("contact", ContactSettings())
-    return rotation_path(mesh, law, 100.0, PathSettings(max_rotation_rad=END_RAD, contact=contact, **settings))
+    swept = through_contact(PathSettings(max_rotation_rad=END_RAD, **settings))
+    return rotation_path(mesh, law, 100.0, replace(swept, contact=contact))
 
 
 @pytest.fixture(scope="module")
@@ -121,8 +124,6 @@ def test_an_increment_that_fails_at_every_step_ends_the_path_saying_where(candid
     # past 0.35 rad every attempt made to fail (as where a fold loses energy, or Newton wanders in a crease, at every
     # step size): the increments past it are cut back to the smallest step, none is kept, and the path ends
     # unconverged with the event there
-    from dataclasses import replace
-
     import seadesign.fea.rotation_path as rp
 
     if failure == "contact_energy_loss":
