@@ -81,7 +81,7 @@ def through_contact(settings: PathSettings) -> PathSettings:
     halves every 10 (`newton.stalled`): a creasing notch's active set can take that many to settle (on the 3 x 8 mm
     candidate's coarse mesh, before the energy balance, 30 ended the path unconverged at 0.558 rad and 60 reached
     0.6 rad), while an attempt whose residual wanders is cut back without spending the 60 (the 8 x 4 mm candidate's
-    path mesh to its crease: 582 s instead of 1321 s, 278 factorizations instead of 626, the same end within
+    path mesh to its crease: 624 s instead of 1321 s, 278 factorizations instead of 626, the same end within
     0.012 rad and 0.5 % in torque)."""
     newton = replace(settings.newton, max_iterations=60, stall_window=10)
     return replace(settings, contact=ContactSettings(), newton=newton)
