@@ -34,7 +34,7 @@ import numpy as np
 from record import Table, add_docs_option, machine, write_fragment
 
 from seadesign.design.study import load_study
-from seadesign.fea.large_deflection import large_deflection
+from seadesign.fea.large_deflection import element_location, large_deflection
 from seadesign.fea.rotation_path import PathSettings, rotation_path, through_contact
 from seadesign.run.cache import Cache
 from seadesign.sweep.stages import SolverSettings, check_geometry, tetrahedralize
@@ -172,7 +172,8 @@ def _contact_cells(path, ld, theta: float) -> list[str]:
     strain = "not reached"
     if theta <= thetas[-1]:
         near = path.points[int(np.argmin(np.abs(thetas - theta)))]
-        at = np.array(path.emesh.nodes_m[path.emesh.elements[near.peak_tensile_element, :4]].mean(axis=0) * 1e3)
+        peak = element_location(path, near.peak_tensile_element)
+        at = np.array([peak.x_mm, peak.y_mm, peak.z_mm])
         gap = (f"{np.linalg.norm(at - np.array(near.contact.peak_at_mm)):.2f}" if near.contact.area_m2 > 0
                else "no contact")
         strain = f"{strain_at(path, theta):.4g} ({gap})"

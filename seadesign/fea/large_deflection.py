@@ -113,7 +113,8 @@ def _crossing(theta: np.ndarray, values: np.ndarray, level: float) -> float:
     return float(theta[i - 1] + s * (theta[i] - theta[i - 1]))
 
 
-def _location(path: TorquePath, element: int) -> PeakLocation:
+def element_location(path: TorquePath, element: int) -> PeakLocation:
+    """The centroid (mm, at rest) of the path mesh's element `element` (NOWHERE for -1)."""
     if element < 0:
         return NOWHERE
     x = path.emesh.nodes_m[path.emesh.elements[element, :4]].mean(axis=0) * 1e3
@@ -145,8 +146,8 @@ def _load_point(path: TorquePath, theta: np.ndarray, torque_Nm: float, limit: fl
         compressive = float(np.interp(rotation, theta, [p.peak_compressive_strain for p in path.points]))
         share = float(np.interp(rotation, theta, [p.contact.moment_Nm for p in path.points])) / torque_Nm
         near = path.points[int(np.argmin(np.abs(theta - rotation)))]
-        tensile_at = _location(path, near.peak_tensile_element)
-        compressive_at = _location(path, near.peak_compressive_element)
+        tensile_at = element_location(path, near.peak_tensile_element)
+        compressive_at = element_location(path, near.peak_compressive_element)
     return LoadPoint(
         torque_Nm=torque_Nm,
         reached=bool(reached),
@@ -207,11 +208,11 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
         single_limit_rotation_rad=single_theta,
         single_limit_torque_Nm=limit_torque(single_theta),
         peak_tensile_strain=worst_tension.peak_tensile_strain,
-        peak_tensile_at=_location(path, worst_tension.peak_tensile_element),
+        peak_tensile_at=element_location(path, worst_tension.peak_tensile_element),
         peak_compressive_strain=worst_compression.peak_compressive_strain,
-        peak_compressive_at=_location(path, worst_compression.peak_compressive_element),
+        peak_compressive_at=element_location(path, worst_compression.peak_compressive_element),
         peak_von_mises_MPa=worst_stress.peak_von_mises_Pa * 1e-6,
-        peak_von_mises_at=_location(path, worst_stress.peak_von_mises_element),
+        peak_von_mises_at=element_location(path, worst_stress.peak_von_mises_element),
         standing=_load_point(path, theta, standing_torque_Nm, cyclic, contact_is_end_stop),
         stall=_load_point(path, theta, stall_torque_Nm, cyclic, contact_is_end_stop),
         impact=_load_point(path, theta, impact_torque_Nm, single, contact_is_end_stop),
