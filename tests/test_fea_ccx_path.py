@@ -114,7 +114,7 @@ def test_calculix_nlgeom_agrees_on_the_default_mesh(tmp_path, ccx):
     assert _ccx_difference(tmp_path, mesh, study.material.law, path).max() < RTOL
 
 
-def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float, friction: float = 0.0):
+def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float):
     """Our path through self-contact on a default-study candidate (4x coarser one-layer mesh) to `end_rad`, and
     CalculiX's on the same mesh with a face-to-face penalty contact pair (ten times our penalty) between the faces
     within 1.5 mm of where our contact touches at the end; CalculiX's torques at our points."""
@@ -131,7 +131,7 @@ def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float, 
     law, settings = study.material.law, PathSettings(max_rotation_rad=end_rad, contact=ContactSettings())
     path = rotation_path(mesh, law, study.load_cases.impact_torque_Nm, settings)
     contact = path_problem(mesh, law, settings).system.contact
-    deck = pair_around(contact, path.displacement_m, 1.5, 10 * contact.penalty_Pa_per_m, friction)
+    deck = pair_around(contact, path.displacement_m, 1.5, 10 * contact.penalty_Pa_per_m)
     theta = [p.rotation_rad for p in path.points[1:]]
     emesh, hub, ring = path_nodes(mesh)
     inp = write_path_inp(tmp_path / "contact.inp", emesh, hub, ring, law, theta, PathIncrements(max_rad=0.02), deck)
@@ -152,3 +152,35 @@ def test_calculix_contact_pair_agrees_through_contact(tmp_path, ccx):
     assert difference[cc.rotation_rad < 0.27].max() < RTOL
     assert difference[cc.rotation_rad >= event.rotation_rad].max() < 1e-3
     assert difference.max() < 1e-3
+
+
+def test_a_node_to_surface_pair_leaves_the_nodes_it_shares_with_the_master_out_of_the_slave():
+    """One C3D10 (nodes 0-3 corners, 4-9 midsides of edges 01, 12, 20, 03, 13, 23): slave face S1 (0, 1, 2) and master
+    face S2 (0, 3, 1) share the edge 0-1 with its midside 4, as a notch's two flanks share its root. The node-to-surface
+    slave is S1's other nodes, 2 and the midsides 5 and 6 (1-based in the deck: 3, 6, 7); the master stays a face."""
+    from seadesign.fea.ccx_contact import ContactPairDeck
+
+    element = np.arange(10)[None, :]
+    slave, master = np.array([[0, 1, 2]]), np.array([[1, 0, 3]])
+    card = ContactPairDeck(slave, master, 3e11, 0.5, 3e11, node_to_surface=True).card(element).splitlines()
+    at = card.index("*SURFACE, NAME=SLAVE, TYPE=NODE")
+    assert card[at + 1 : at + 4] == ["3", "6", "7"] and card[at + 4] == "*SURFACE, NAME=MASTER, TYPE=ELEMENT"
+    assert card[at + 5] == "1, S2"
+    assert "*CONTACT PAIR, INTERACTION=TOUCH, TYPE=NODE TO SURFACE" in card and "*FRICTION" in card
+    face_to_face = ContactPairDeck(slave, master, 3e11).card(element).splitlines()
+    assert "1, S1" in face_to_face and "*CONTACT PAIR, INTERACTION=TOUCH, TYPE=SURFACE TO SURFACE" in face_to_face
+
+
+def test_the_path_deck_leaves_the_field_controls_to_calculix_when_asked_and_writes_the_time_controls(tmp_path):
+    """`PathIncrements(residual_rtol=None, time_controls=...)`: no *CONTROLS, PARAMETERS=FIELD card (ccx's default
+    tolerance) and the time incrementation line in every step; by default the tight FIELD card and no time line."""
+    mesh = annulus_mesh(5.0, 12.0, 3.0, n_r=1, n_theta=8, n_z=1)
+    emesh, hub, ring = path_nodes(mesh)
+    theta = [0.01, 0.02]
+    loose = write_path_inp(tmp_path / "loose.inp", emesh, hub, ring, LAW, theta,
+                           PathIncrements(residual_rtol=None, time_controls="8,10,9,30,10,4,,10")).read_text()
+    assert "PARAMETERS=FIELD" not in loose
+    assert loose.count("*CONTROLS, PARAMETERS=TIME INCREMENTATION\n8,10,9,30,10,4,,10\n") == len(theta)
+    tight = write_path_inp(tmp_path / "tight.inp", emesh, hub, ring, LAW, theta, PathIncrements()).read_text()
+    assert tight.count("*CONTROLS, PARAMETERS=FIELD\n1.000e-07, , , , 1.000e-07\n") == len(theta)
+    assert "TIME INCREMENTATION" not in tight

@@ -206,11 +206,14 @@ class PathIncrements:
     rotation): each step starts with its whole rotation, at most `max_rad`, and ccx cuts back down to
     `min_rad`; `residual_rtol` is ccx's convergence criterion, its largest residual force over its
     average nodal force (ccx's default, 0.005, left torque errors of 1.2e-6 on the test annulus; 1e-7
-    leaves only the .dat's printed digits, 6e-8, for one more iteration in six)."""
+    leaves only the .dat's printed digits, 6e-8, for one more iteration in six); None leaves ccx's field defaults
+    (no *CONTROLS, PARAMETERS=FIELD). `time_controls`: a *CONTROLS, PARAMETERS=TIME INCREMENTATION line (I0, IR, IP,
+    IC, IL, IG, IS, IA) in every step, None for ccx's defaults (4, 8, 9, 16, 10, 4, 0, 5)."""
 
     max_rad: float = 0.1
     min_rad: float = 1e-6
-    residual_rtol: float = 1e-7
+    residual_rtol: float | None = 1e-7
+    time_controls: str | None = None
 
 
 #: a compressibility that leaves its volumetric term out of CalculiX's energy (1/Pa)
@@ -274,7 +277,11 @@ def write_path_inp(
             first, rtol = min(increments.max_rad, span), increments.residual_rtol
             f.write(f"*STEP, NLGEOM, INC={int(np.ceil(span / increments.min_rad)) + 1}\n*STATIC\n"
                     f"{first:.12e}, {span:.12e}, {increments.min_rad:.12e}, {first:.12e}\n")
-            f.write(f"*CONTROLS, PARAMETERS=FIELD\n{rtol:.3e}, , , , {rtol:.3e}\n*BOUNDARY\n")
+            if rtol is not None:
+                f.write(f"*CONTROLS, PARAMETERS=FIELD\n{rtol:.3e}, , , , {rtol:.3e}\n")
+            if increments.time_controls is not None:
+                f.write(f"*CONTROLS, PARAMETERS=TIME INCREMENTATION\n{increments.time_controls}\n")
+            f.write("*BOUNDARY\n")
             np.savetxt(f, np.column_stack([ids, dofs, dofs, u]), fmt=["%d", "%d", "%d", "%.12e"], delimiter=", ")
             f.write(f"*NODE PRINT, NSET=HUB, FREQUENCY={_NEVER}\nU, RF\n*END STEP\n")
     return path

@@ -18,6 +18,10 @@ TOUCHING_MM = 0.01  # a pair this close touches (a converged path's pressed pair
 
 #: C3D10's faces by their corner nodes (0-based within the element), faces S1 to S4
 _TET_FACES = ((0, 1, 2), (0, 3, 1), (1, 3, 2), (2, 3, 0))
+#: the same faces' corner and midside nodes (C3D10's midsides 4 to 9 on the edges 01, 12, 20, 03, 13, 23)
+_TET_FACE_NODES = ((0, 1, 2, 4, 5, 6), (0, 3, 1, 7, 8, 4), (1, 3, 2, 8, 9, 5), (2, 3, 0, 9, 7, 6))
+#: node-to-surface contact's tension for large clearances (Pa): CalculiX's sigma_infinity, negligible here
+_N2F_TENSION_PA = 1.0
 
 
 def element_faces(elements: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -32,40 +36,63 @@ def element_faces(elements: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray
     return hits // 4, hits % 4 + 1
 
 
+def face_nodes(elements: np.ndarray, facets: np.ndarray) -> np.ndarray:
+    """The nodes (0-based, sorted) of boundary facets (k, 3 corner nodes) of a C3D10 mesh: corners and midsides."""
+    element, face = element_faces(elements, facets)
+    return np.unique(elements[element[:, None], np.array(_TET_FACE_NODES)[face - 1]])
+
+
 @dataclass(frozen=True)
 class ContactPairDeck:
     """A frictional or frictionless contact pair for a CalculiX deck: the slave and master surfaces as boundary
-    facets (k, 3 corner nodes, 0-based), face-to-face penalty contact with a linear pressure-overclosure law of slope
-    `penalty_Pa_per_m`; Coulomb friction `friction` (0: frictionless) with stick slope `stick_Pa_per_m`."""
+    facets (k, 3 corner nodes, 0-based), penalty contact with a linear pressure-overclosure law of slope
+    `penalty_Pa_per_m`; Coulomb friction `friction` (0: frictionless) with stick slope `stick_Pa_per_m`.
+
+    `node_to_surface` False: face-to-face (TYPE=SURFACE TO SURFACE) between the two facet sets. True: node-to-surface,
+    the slave the slave facets' nodes (corners and midsides) less any node of a master facet. Where the two sets
+    share an edge (a notch's root folding shut: the pair is a face and its neighbour), face-to-face pairs the slave
+    face's integration points at that edge with the master face across it, a contact element whose slave and master
+    are the same nodes; frictionless it is harmless, with friction its stick/slip never settles (CalculiX cut to
+    1.6e-4 rad and stopped at 0.261 rad on the 3 x 8 mm candidate, before any real contact). Node-to-surface leaves
+    the shared nodes out of the slave."""
 
     slave: np.ndarray
     master: np.ndarray
     penalty_Pa_per_m: float
     friction: float = 0.0
     stick_Pa_per_m: float = 0.0
+    node_to_surface: bool = False
 
     def card(self, elements: np.ndarray) -> str:
         """The *SURFACE, *SURFACE INTERACTION and *CONTACT PAIR cards (model data)."""
         lines = []
-        for name, facets in (("SLAVE", self.slave), ("MASTER", self.master)):
+        if self.node_to_surface:
+            nodes = np.setdiff1d(face_nodes(elements, self.slave), face_nodes(elements, self.master))
+            if not len(nodes):
+                raise SolverError("every slave node is on the master surface: no node-to-surface pair")
+            lines.append("*SURFACE, NAME=SLAVE, TYPE=NODE")
+            lines += [f"{n + 1}" for n in nodes]
+        sides = (("MASTER", self.master),) if self.node_to_surface else (("SLAVE", self.slave), ("MASTER", self.master))
+        for name, facets in sides:
             element, face = element_faces(elements, facets)
             lines.append(f"*SURFACE, NAME={name}, TYPE=ELEMENT")
             lines += [f"{e + 1}, S{k}" for e, k in zip(element, face)]
-        lines += ["*SURFACE INTERACTION, NAME=TOUCH", "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
-                  f"{self.penalty_Pa_per_m:.6e}"]
+        behavior = f"{self.penalty_Pa_per_m:.6e}" + (f", {_N2F_TENSION_PA:.6e}" if self.node_to_surface else "")
+        lines += ["*SURFACE INTERACTION, NAME=TOUCH", "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", behavior]
         if self.friction > 0:
             lines += ["*FRICTION", f"{self.friction:.6e}, {self.stick_Pa_per_m:.6e}"]
-        lines += ["*CONTACT PAIR, INTERACTION=TOUCH, TYPE=SURFACE TO SURFACE", "SLAVE, MASTER"]
+        kind = "NODE TO SURFACE" if self.node_to_surface else "SURFACE TO SURFACE"
+        lines += [f"*CONTACT PAIR, INTERACTION=TOUCH, TYPE={kind}", "SLAVE, MASTER"]
         return "\n".join(lines) + "\n"
 
 
 def pair_around(contact: FrictionlessContact, u: np.ndarray, reach_mm: float, penalty_Pa_per_m: float,
-                friction: float = 0.0) -> ContactPairDeck:
+                friction: float = 0.0, node_to_surface: bool = False) -> ContactPairDeck:
     """The slave and master surfaces around the pairs that touch at u (our path's solution; gap below `TOUCHING_MM`):
     the faces of `contact`'s surface within `reach_mm` of a touching pair's face at rest, each given to the side of
     the nearest pair whose face it turns like (the checked point's face: slave; the facet's face: master), a face
     turned like neither (cosine 0.3 or less) to none. `friction`: Coulomb's coefficient, with the stick slope the
-    penalty's."""
+    penalty's. `node_to_surface`: as `ContactPairDeck`'s."""
     pairs = contact.pairs(u, contact.search(u))
     touching = pairs.gap_m < TOUCHING_MM * MM
     if not touching.any():
@@ -85,4 +112,4 @@ def pair_around(contact: FrictionlessContact, u: np.ndarray, reach_mm: float, pe
     on_slave = near & (like_slave > 0.3) & (like_slave > like_master)
     on_master = near & (like_master > 0.3) & (like_master > like_slave)
     return ContactPairDeck(corners[on_slave], corners[on_master], penalty_Pa_per_m, friction,
-                           penalty_Pa_per_m if friction > 0 else 0.0)
+                           penalty_Pa_per_m if friction > 0 else 0.0, node_to_surface)
