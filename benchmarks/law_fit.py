@@ -53,13 +53,14 @@ def main() -> None:
     spring = json.loads(args.spring.read_text())
     if args.cold or args.sweep:
         from seadesign.design.study import load_study
+        from seadesign.mesh import MESH_STAGE
         from seadesign.run.cache import Cache, default_cache
         from seadesign.sweep.path_stage import path_key
         from seadesign.sweep.stages import SolverSettings
 
         warm, cold = default_cache(), Cache(Path(tempfile.mkdtemp(prefix="law_fit_cache_")))
         os.environ["SEADESIGN_CACHE"] = str(cold.root)
-        for stage in ("geometry", "mesh", "fea", "coarse_k") if args.sweep else ():
+        for stage in ("geometry", MESH_STAGE, "fea", "coarse_k") if args.sweep else ():
             if (warm.root / stage).is_dir():
                 shutil.copytree(warm.root / stage, cold.root / stage)
         study = load_study(spring["study"])
