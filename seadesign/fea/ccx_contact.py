@@ -16,10 +16,10 @@ from seadesign.fea.torsion import MM
 
 TOUCHING_MM = 0.01  # a pair this close touches (a converged path's pressed pairs penetrate by the tolerance, 0.0045 mm)
 
-#: C3D10's faces by their corner nodes (0-based within the element), faces S1 to S4
-_TET_FACES = ((0, 1, 2), (0, 3, 1), (1, 3, 2), (2, 3, 0))
-#: the same faces' corner and midside nodes (C3D10's midsides 4 to 9 on the edges 01, 12, 20, 03, 13, 23)
+#: C3D10's faces S1 to S4 by their corner and midside nodes (0-based within the element; midsides 4 to 9 on the
+#: edges 01, 12, 20, 03, 13, 23)
 _TET_FACE_NODES = ((0, 1, 2, 4, 5, 6), (0, 3, 1, 7, 8, 4), (1, 3, 2, 8, 9, 5), (2, 3, 0, 9, 7, 6))
+_TET_FACES = tuple(face[:3] for face in _TET_FACE_NODES)  # by their corners
 #: node-to-surface contact's tension for large clearances (Pa): CalculiX's sigma_infinity, negligible here
 _N2F_TENSION_PA = 1.0
 
