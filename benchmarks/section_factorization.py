@@ -47,8 +47,8 @@ def timed(upper: sp.csr_matrix | sp.bsr_matrix, repeats: int) -> tuple[float, fl
     return min(first), min(again)
 
 
-def section_stiffness(points_mm: np.ndarray, boundary_faces: np.ndarray, held_xy_m: np.ndarray,
-                      youngs_Pa: float) -> sp.csr_matrix:
+def section_stiffness(points_mm: np.ndarray, boundary_faces: np.ndarray, held_xy_m: np.ndarray, youngs_Pa: float,
+                      poisson_ratio: float) -> sp.csr_matrix:
     """Upper triangle of a P2 plane-elasticity stiffness on the top face's triangles, the dofs over `held_xy_m` held."""
     z = points_mm[:, 2]
     top = boundary_faces[np.all(np.isclose(z[boundary_faces], z.max()), axis=1)]
@@ -57,7 +57,7 @@ def section_stiffness(points_mm: np.ndarray, boundary_faces: np.ndarray, held_xy
     index[used] = np.arange(len(used))
     mesh = skfem.MeshTri(np.ascontiguousarray(points_mm[used, :2].T * MM), np.ascontiguousarray(index[top].T))
     basis = skfem.Basis(mesh, skfem.ElementVector(skfem.ElementTriP2()))
-    k = linear_elasticity(*lame_parameters(youngs_Pa, 0.45)).assemble(basis)
+    k = linear_elasticity(*lame_parameters(youngs_Pa, poisson_ratio)).assemble(basis)
     near, _ = cKDTree(held_xy_m).query(basis.doflocs.T, distance_upper_bound=1e-9)
     free = np.flatnonzero(~np.isfinite(near))
     return sp.triu(k[free][:, free]).tocsr()
@@ -80,7 +80,8 @@ def main() -> None:
             p = path_problem(mesh, study.material.law, PathSettings())
             k3 = p.solid.tangent(np.zeros_like(p.solid.mesh.nodes_m), p.system.pattern).matrix()
             held = p.solid.mesh.nodes_m[p.drive.prescribed, :2]
-            k2 = section_stiffness(mesh.points_mm, mesh.boundary_faces, held, study.material.youngs_modulus_Pa)
+            k2 = section_stiffness(mesh.points_mm, mesh.boundary_faces, held, study.material.youngs_modulus_Pa,
+                                   study.material.poisson_ratio)
             solid, plane = timed(k3, args.repeats), timed(k2, args.repeats)
             label = f"{beams} beams x {thickness} mm"
             table.add(label, f"3D path mesh ({len(mesh.tets)} P2 tetrahedra)", k3.shape[0], f"{solid[0]:.3f}",
