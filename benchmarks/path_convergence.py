@@ -20,7 +20,8 @@ STRAIN_TORQUE_KNOCKDOWN`).
 setting with `[ranking] self_contact`); each mesh's row then also gives first contact (rad, Nm), why and where contact
 ended the path if it ended unconverged, and at the last listed rotation the peak tensile strain with its distance
 (mm, at rest) from where the contact presses hardest: the strain in the contact zone when that distance is small.
-`--docs` then writes docs/validation/_fragments/path_convergence_contact.md.
+`--docs` then writes docs/validation/_fragments/path_convergence_contact.md, or with more than one mesh
+path_convergence_contact_meshes.md (one candidate's meshes against each other).
 
 `--docs` writes the table against the finest mesh (docs/validation/_fragments/path_convergence.md) and, with
 `--strain-levels`, the torques at each strain level (strain_knockdown.md).
@@ -74,7 +75,8 @@ def main() -> None:
                     help="the path's largest step (rad): smaller steps check that no narrow instability is stepped over")
     ap.add_argument("--contact", action="store_true", help="through frictionless self-contact (the sweep's "
                     "self_contact setting)")
-    add_docs_option(ap, "path_convergence", "strain_knockdown", "path_convergence_contact")
+    add_docs_option(ap, "path_convergence", "strain_knockdown", "path_convergence_contact",
+                    "path_convergence_contact_meshes")
     args = ap.parse_args()
     settings = PathSettings(max_step_rad=args.max_step_rad)
     settings = through_contact(settings) if args.contact else settings
@@ -150,8 +152,8 @@ def main() -> None:
             f"{n} at {x:g}: {r:.4f}" for n, x, r in ratios))
         print(f"largest path-mesh overestimate: {name} at strain {level:g}: x {worst:.4f}; knock-down on the path's "
               f"strain-limit torques: {min(1.0, 1.0 / worst):.4f}")
-    if args.docs and args.contact:
-        write_fragment("path_convergence_contact", through, f"Study {st.name}; meshes {args.meshes} (path: the "
+    if args.docs and args.contact:  # candidates on one mesh, or one candidate's meshes against each other
+        write_fragment("path_convergence_contact" + ("_meshes" if len(meshes) > 1 else ""), through, f"Study {st.name}; meshes {args.meshes} (path: the "
                        f"sweep's path mesh, 1: the result mesh); through frictionless self-contact")
     elif args.docs:
         settings_text = (f"Study {st.name}; meshes {args.meshes} (a number: that coarsening of the study's mesh, 1 the "
