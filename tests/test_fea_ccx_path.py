@@ -139,18 +139,24 @@ def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float):
 
 
 @pytest.mark.slow
-def test_calculix_contact_pair_agrees_through_contact(tmp_path, ccx):
-    """3 x 8 mm through contact to 0.42 rad (first contact 0.318 rad): before contact CalculiX's contact pair stays
-    open and the torques agree as without contact (measured 1.5e-8, and 9.4e-5 at 0.286 rad, 0.03 rad before our
-    first contact: CalculiX's face-to-face contact starts to push before the faces touch); through contact they
-    agree within 4.5e-4 (measured; the issue asks 1 %). Ours 12 s, CalculiX 64 s on 2 cores."""
-    path, cc = _through_contact(tmp_path, 3, 8.0, 0.42)
+@pytest.mark.parametrize("beams, thickness_mm, end_rad", [(3, 8.0, 0.42), (6, 8.0, 0.40)])
+def test_calculix_contact_pair_agrees_through_contact(tmp_path, ccx, beams, thickness_mm, end_rad):
+    """Two default-study candidates through contact, to `end_rad` or to where our path stops, on their coarse meshes.
+    Before contact CalculiX's contact pair stays open and the torques agree as without contact (measured at most
+    2.8e-8; on 3 x 8 mm 9.4e-5 at 0.286 rad, 0.03 rad before our first contact: CalculiX's face-to-face contact
+    starts to push before the faces touch); through contact they agree within 4.5e-4 (the issue asks 1 %).
+    - 3 x 8 mm: first contact 0.318 rad, the hub notch; to 0.42 rad. Ours 12 s, CalculiX 64 s on 2 cores.
+    - 6 x 8 mm, the default study's nearest design: first contact 0.307 rad, the hub notch; contact carries up to
+      1.3 % of the torque; our path ends unconverged at 0.341 rad (`contact_unconverged`), CalculiX follows it
+      there; measured through contact 7.7e-5 to 4.0e-4. Ours 40-60 s, CalculiX 135 s."""
+    path, cc = _through_contact(tmp_path, beams, thickness_mm, end_rad)
     assert cc.failure is None and len(cc.rotation_rad) == len(path.points) - 1
-    (event,) = path.events
+    first = path.events[0]
+    assert first.kind == "contact"
     ours = np.array([p.torque_Nm for p in path.points[1:]])
     difference = np.abs(cc.torque_Nm / ours - 1.0)
-    assert difference[cc.rotation_rad < 0.27].max() < RTOL
-    assert difference[cc.rotation_rad >= event.rotation_rad].max() < 1e-3
+    assert (cc.rotation_rad >= first.rotation_rad).sum() >= 2  # points in contact to compare
+    assert difference[cc.rotation_rad < first.rotation_rad - 0.04].max() < RTOL
     assert difference.max() < 1e-3
 
 
