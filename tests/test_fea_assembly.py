@@ -141,7 +141,7 @@ def test_pardiso_inertia_counts_the_negative_eigenvalues(small, negatives):
 
 
 def test_pardiso_gives_the_same_digits_every_time_on_several_threads():
-    """MKL's reproducibility mode is on; without it, PARDISO's four-thread factorization of this matrix (a shifted
+    """MKL's reproducibility mode is on, with a fixed number of threads; without it, PARDISO's four-thread factorization of this matrix (a shifted
     3D Laplacian, 47k unknowns) gave solutions that differ in the last digit within 10 repeats in 4 of 6 runs."""
     import ctypes
 
@@ -152,6 +152,8 @@ def test_pardiso_gives_the_same_digits_every_time_on_several_threads():
     lib = _library()
     lib.MKL_CBWR_Get.restype, lib.MKL_CBWR_Get.argtypes = ctypes.c_int, [ctypes.c_int]
     assert lib.MKL_CBWR_Get(1) == _CBWR_AUTO  # MKL_CBWR_BRANCH: the code branch in use
+    lib.MKL_Get_Dynamic.restype, lib.MKL_Get_Dynamic.argtypes = ctypes.c_int, []
+    assert lib.MKL_Get_Dynamic() == 0  # a fixed number of threads, as reproducibility needs
 
     n = 36
     line, one = sp.diags([-1.0, 2.2, -1.0], [-1, 0, 1], shape=(n, n)), sp.identity(n)

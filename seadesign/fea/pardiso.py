@@ -4,8 +4,10 @@ positive-definite matrices stored as their upper triangle, in CSR or in 3x3-bloc
 MKL runs in conditional-numerical-reproducibility mode (MKL_CBWR=AUTO unless the environment sets
 MKL_CBWR): with more than one thread, PARDISO's factorization otherwise differs in the last digits from
 run to run (a large-deflection path by 1e-13 Nm), and the explorer, which fits its surrogates on those
-digits, took another route on every run. Results may still depend on the number of threads (MKL promises
-reproducibility for a fixed number).
+digits, took another route on every run. MKL promises that only for a fixed number of threads, so it is
+also kept from choosing fewer threads when the machine is busy (MKL_DYNAMIC=FALSE unless the environment
+sets MKL_DYNAMIC; Intel's reproducibility conditions): a path through a creasing notch amplifies the last
+digits. Results may still depend on the number of threads.
 
 Block storage matters: PARDISO then orders the node graph, nine times smaller than the
 scalar one (measured in docs/validation/linear-fea.md).
@@ -56,6 +58,9 @@ def _library() -> ctypes.CDLL:
         lib.MKL_CBWR_Set.restype, lib.MKL_CBWR_Set.argtypes = ctypes.c_int, [ctypes.c_int]
         if "MKL_CBWR" not in os.environ and lib.MKL_CBWR_Set(_CBWR_AUTO) != 0:
             raise SolverError(f"{path}: MKL refused conditional numerical reproducibility (MKL_CBWR_Set)")
+        if "MKL_DYNAMIC" not in os.environ:
+            lib.MKL_Set_Dynamic.restype, lib.MKL_Set_Dynamic.argtypes = None, [ctypes.c_int]
+            lib.MKL_Set_Dynamic(0)
         return lib
     raise SolverError("MKL PARDISO not found: `pip install mkl`, or choose linear_solver='scipy'")
 
