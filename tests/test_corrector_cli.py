@@ -153,9 +153,10 @@ def _with_curve(spring_dict: dict, end_Nm: float, hard_stop: bool = False) -> di
 
 def test_train_refuses_before_training_a_spring_whose_curve_ends_before_the_protocol_loads(tmp_path, spring_dict):
     """The ground protocol loads the thesis spring to a few Nm: a curve that ends at 1 Nm cannot carry it, and train
-    refuses before any training, naming the load, where the curve ends and why, and the remedy; a curve that
-    reaches past the loads, or ends at a hard stop, passes the check."""
-    from seadesign.corrector.preflight import check_spring_range, protocol_loads
+    refuses before any training, naming the load, where the curve ends and why, and the remedy (the path through
+    self-contact for a curve that stopped at contact, not for one that bifurcated); a curve that reaches past the
+    loads, or ends at a hard stop, passes the check."""
+    from seadesign.corrector.preflight import SpringRangeError, check_spring_range, protocol_loads
 
     loads = protocol_loads(spring_dict)
     ground = next(load for load in loads if "ground" in load.what)
@@ -166,7 +167,13 @@ def test_train_refuses_before_training_a_spring_whose_curve_ends_before_the_prot
     text = " ".join(res.output.split())
     assert "the spring cannot carry what training needs: the simulator's ground protocol loads the spring to" in text
     assert "Its torque curve ends at" in text and "1 Nm (stop reason contact" in text and "Remedy:" in text
+    assert "the path through frictionless self-contact can go on past it (`[ranking] self_contact = true`" in text
     assert not (tmp_path / "m").exists()
+    bifurcating = _with_curve(spring_dict, 1.0)
+    bifurcating["torque_curve"]["stop_reason"] = "bifurcation"
+    with pytest.raises(SpringRangeError) as refusal:
+        check_spring_range(bifurcating)
+    assert "Remedy:" in str(refusal.value) and "self_contact" not in str(refusal.value)  # contact is not its end
     check_spring_range(_with_curve(spring_dict, 1.01 * max(load.torque_Nm for load in loads)))  # reaches past: passes
     check_spring_range(_with_curve(spring_dict, 1.0, hard_stop=True))  # the end stop carries the rest
 

@@ -2,7 +2,8 @@
 
 The knee simulator reads the spring from spring.json's large-deflection curve, which is never extrapolated
 (`design.spring.TorqueCurve`): a rotation past its end raises part-way through training. So `seadesign train`
-checks first, and refuses with the load the spring cannot carry, where its curve ends and why, and the remedy:
+checks first, and refuses with the load the spring cannot carry, where its curve ends and why, and the remedy (for a
+curve that stopped at contact, also the path through self-contact):
 the simulator's protocols (hanging and on the ground, every training speed) load the spring by gravity and the
 leg's motion; one uncorrected rollout per setting with a linear spring of the same k gives the peak spring
 torque, and the softest training scale s (the spring's torque x s) must carry it on the curve: peak / s <= the
@@ -71,8 +72,11 @@ def _refusal(spring: dict[str, Any], curve: TorqueCurve, beyond: list[Load]) -> 
     selection = spring.get("selection", {})
     verdict = ("" if selection.get("meets_requirements", True) else
                f" This spring does not meet its study's requirements ({selection.get('failed_constraints', '')}).")
+    through = (" Its path stopped where a gap between facing surfaces closed, without contact forces: the path "
+               "through frictionless self-contact can go on past it (`[ranking] self_contact = true` in the study, then "
+               "sweep again; 10-20 minutes a candidate on 2 cores)." if curve.stop_reason == "contact" else "")
     return ("the spring cannot carry what training needs: " + "; ".join(load.what for load in beyond)
             + f". Its torque curve ends at {curve.end_rotation_rad:.4g} rad, {curve.end_torque_Nm:.4g} Nm (stop reason "
             f"{curve.stop_reason}: the large-deflection path ends there, and the curve is not extrapolated)."
             + verdict + " Remedy: hand on a spring whose curve reaches these loads (a stiffer design, or one that "
-            "meets the requirements: see the sweep's report). Nothing was trained.")
+            "meets the requirements: see the sweep's report)." + through + " Nothing was trained.")
