@@ -167,7 +167,8 @@ def test_train_refuses_before_training_a_spring_whose_curve_ends_before_the_prot
     text = " ".join(res.output.split())
     assert "the spring cannot carry what training needs: the simulator's ground protocol loads the spring to" in text
     assert "Its torque curve ends at" in text and "1 Nm (stop reason contact" in text and "Remedy:" in text
-    assert "the path through frictionless self-contact can go on past it (`[ranking] self_contact = true`" in text
+    assert "the path through frictionless self-contact can go on past it (`seadesign sweep STUDY " \
+           "--handoff-through-contact` hands on the chosen design's" in text
     assert not (tmp_path / "m").exists()
     bifurcating = _with_curve(spring_dict, 1.0)
     bifurcating["torque_curve"]["stop_reason"] = "bifurcation"

@@ -57,6 +57,40 @@ def test_outputs_exist_and_choice_is_the_valid_candidate(tiny):
     assert f"material ninjaflex {nf['path']} (sha256 {nf['sha256']})" in (folder / "report.md").read_text()
 
 
+@pytest.mark.slow
+def test_the_handoff_through_contact_carries_the_curve_past_the_closing_gap(tmp_path):
+    """--handoff-through-contact on the tiny study's mesh of 6 beams x 8 mm, whose path stops where a gap closes
+    (0.417 rad, 11.4 Nm): spring.json then carries its path with self-contact instead. Before contact the two curves
+    are one (the same law, mesh and increments: the same torques at the same rotations); first contact is near where the contact-free path stopped (it stops where
+    its facing nodes come within 0.1 mm; contact presses at Gauss points against facets); the curve goes on, here
+    past the stall torque (12.5 Nm at 0.514 rad, a bifurcation); the ranking stays the one without contact forces.
+    About 2 minutes."""
+    study = write_tiny_study(tmp_path, beam_count="[6, 10]")
+    common = [str(study), "--jobs", "1", "--quiet", "--cache-dir", str(tmp_path / "cache")]
+    result = CliRunner().invoke(main, ["sweep", *common, "--out", str(tmp_path / "plain")])
+    assert result.exit_code == 0, result.output
+    plain = load_spring(tmp_path / "plain" / "tiny" / "spring.json")
+    assert plain["torque_curve"]["stop_reason"] == "contact"
+    result = CliRunner().invoke(main, ["sweep", *common, "--out", str(tmp_path / "handed"), "--handoff-through-contact"])
+    assert result.exit_code == 0, result.output
+    assert "spring.json: the curve goes on with frictionless self-contact past where the gap closed: first contact " \
+           "at" in " ".join(result.output.split())
+    handed = load_spring(tmp_path / "handed" / "tiny" / "spring.json")
+    before, after = TorqueCurve.from_handoff(plain["torque_curve"]), TorqueCurve.from_handoff(handed["torque_curve"])
+    assert after.stop_reason != "contact" and after.end_torque_Nm > 1.05 * before.end_torque_Nm
+    assert after.end_torque_Nm > handed["actuator"]["stall_torque_Nm"] > before.end_torque_Nm
+    first = handed["large_deflection"]["contact_rotation_rad"]
+    assert abs(first - before.end_rotation_rad) < 0.05
+    common, i, j = np.intersect1d(np.round(before.rotation_rad, 12), np.round(after.rotation_rad, 12),
+                                  return_indices=True)
+    assert len(common) >= 5 and common[1] < 0.05 and common[-1] > 0.5 * first  # the same increments before contact
+    assert np.allclose(np.array(after.torque_Nm)[j], np.array(before.torque_Nm)[i], rtol=1e-9, atol=0.0)
+    assert "with frictionless self-contact" in handed["selection"]["curve"]
+    assert handed["selection"]["rank"] == plain["selection"]["rank"] and handed["design"] == plain["design"]
+    assert pd.read_csv(tmp_path / "handed" / "tiny" / "results.csv")["large_stop_reason"].tolist() == \
+        pd.read_csv(tmp_path / "plain" / "tiny" / "results.csv")["large_stop_reason"].tolist()  # ranked without contact
+
+
 def test_sweep_report_opens_with_the_decision_in_a_browser(tiny):
     """Headless Chromium: no error, every image loads, the decision is in the first 1366 x 768 screen."""
     _, _, out = tiny

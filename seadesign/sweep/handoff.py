@@ -1,5 +1,6 @@
 """spring.json for the chosen candidate: k, its error estimate, design, material, the linear load cases,
-and the large-deflection torque curve with its reading at the loads."""
+and the large-deflection torque curve with its reading at the loads; optionally that curve through self-contact
+(`through_contact_row`) where the ranking's path stopped at contact."""
 
 from __future__ import annotations
 
@@ -12,7 +13,8 @@ import pandas as pd
 
 from seadesign.design.spring import SCHEMA_VERSION, write_spring
 from seadesign.design.study import Study
-from seadesign.run.cache import digest
+from seadesign.run.cache import Cache, digest
+from seadesign.sweep.stages import SolverSettings
 
 def _number(value) -> float | None:
     v = float(value)
@@ -96,3 +98,28 @@ def write_handoff(study: Study, t: pd.DataFrame, row: pd.Series, folder: Path, s
     """spring.json of the chosen row, hashed over every evaluated row and the study's robot data."""
     inputs_hash = digest("spring", list(t["row_key"]), study.ranking, study.requirements, study.robot, study.actuator)
     return write_spring(spring_document(study, row, inputs_hash, settings["versions"], selection), folder / "spring.json")
+
+
+def through_contact_row(study: Study, row: pd.Series, solver: SolverSettings, cache: Cache) -> pd.Series:
+    """The row with its large-deflection columns (`large_`) from its candidate's path through frictionless
+    self-contact (the study's `[ranking] self_contact`, on the same path mesh, via the stage cache): what the spring
+    does past the gap its ranking's path stopped at. The other columns (the requirements' verdicts among them) stay
+    the ranking's."""
+    from seadesign.sweep.single import candidate_path  # the path stage's solver: only when asked for
+    from seadesign.sweep.table import path_columns
+
+    contact_study = dataclasses.replace(study, ranking=dataclasses.replace(study.ranking, self_contact=True))
+    path = candidate_path(contact_study, study.candidate_of_row(row), settings=solver, cache=cache)
+    out = row.copy()
+    for key, value in path_columns(path.response, contact_study).items():
+        out[key] = value
+    return out
+
+
+def through_contact_note(row: pd.Series) -> str:
+    """One line on a `through_contact_row`'s curve: first contact, and where and why the path ends (rad, Nm)."""
+    first = (f"first contact at {row['large_contact_rotation_rad']:.4f} rad, {row['large_contact_torque_Nm']:.4g} Nm"
+             if np.isfinite(row["large_contact_rotation_rad"]) else "the faces never touch")
+    return (f"the curve goes on with frictionless self-contact past where the gap closed: {first}; it ends at "
+            f"{row['large_stop_rotation_rad']:.4f} rad, {row['large_stop_torque_Nm']:.4g} Nm "
+            f"({row['large_stop_reason']})")
