@@ -86,6 +86,8 @@ def test_the_handoff_through_contact_carries_the_curve_past_the_closing_gap(tmp_
     assert len(common) >= 5 and common[1] < 0.05 and common[-1] > 0.5 * first  # the same increments before contact
     assert np.allclose(np.array(after.torque_Nm)[j], np.array(before.torque_Nm)[i], rtol=1e-9, atol=0.0)
     assert "with frictionless self-contact" in handed["selection"]["curve"]
+    report = (tmp_path / "handed" / "tiny" / "report.md").read_text()
+    assert "Handoff" in report and handed["selection"]["curve"] in " ".join(report.split())
     assert handed["selection"]["rank"] == plain["selection"]["rank"] and handed["design"] == plain["design"]
     assert pd.read_csv(tmp_path / "handed" / "tiny" / "results.csv")["large_stop_reason"].tolist() == \
         pd.read_csv(tmp_path / "plain" / "tiny" / "results.csv")["large_stop_reason"].tolist()  # ranked without contact

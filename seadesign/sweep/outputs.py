@@ -77,6 +77,7 @@ def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, s
         written["spring"] = [write_handoff(study, t, row if handed is None else handed, folder, settings, selection)]
     written["cad"] = export_cad(study, cad_rows, folder, tolerance_mm, cache)
     written["images"] = [*figures.values(), *renders.values()]
-    page = sweep_page(study, t, choice, settings, figures, renders, baseline)
+    page = sweep_page(study, t, choice, settings, figures, renders, baseline,
+                      None if handed is None else selection["curve"])
     written["report"] = [write_markdown(folder / "report.md", page), write_html(folder / "report.html", page)]
     return written
