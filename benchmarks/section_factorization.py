@@ -4,7 +4,7 @@ same part at the same in-plane sizing: the floor under a path's time (docs/valid
 Usage: python benchmarks/section_factorization.py [--candidates 6x8,8x4] [--repeats 3] [--docs]
 Per candidate: the 3D tangent at rest on the free nodes of the path mesh (P2 tetrahedra, `SolverSettings.path_layers`
 layers through the thickness; hub and ring prescribed), and a plane-elasticity stiffness on the P2 triangles of the
-same mesh's top face (scikit-fem; the nodes over the 3D prescribed ones held), each factored by PARDISO's LDL^T
+same mesh's top face (scikit-fem, `section_path.Section`; the nodes over the 3D hub and ring held), each factored by PARDISO's LDL^T
 with inertia as the path factors (`fea.pardiso.Pardiso(..., indefinite=True)`) on the current MKL threads: the
 analysis with the first factorization, and a refactorization on the same pattern, the fastest of `--repeats`,
 back to back in one process. The section is not a model of the part yet (no finite strain, no contact, no
@@ -20,17 +20,12 @@ from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
-import skfem
 from record import Table, add_docs_option, machine, write_fragment
-from scipy.spatial import cKDTree
+from section_path import Section, path_meshes
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from seadesign.design.study import load_study
 from seadesign.fea.pardiso import Pardiso
-from seadesign.fea.rotation_path import PathSettings, path_problem
-from seadesign.fea.torsion import MM
-from seadesign.run.cache import Cache
-from seadesign.sweep.stages import SolverSettings, tetrahedralize
 
 
 def timed(upper: sp.csr_matrix | sp.bsr_matrix, repeats: int) -> tuple[float, float]:
@@ -47,22 +42,6 @@ def timed(upper: sp.csr_matrix | sp.bsr_matrix, repeats: int) -> tuple[float, fl
     return min(first), min(again)
 
 
-def section_stiffness(points_mm: np.ndarray, boundary_faces: np.ndarray, held_xy_m: np.ndarray, youngs_Pa: float,
-                      poisson_ratio: float) -> sp.csr_matrix:
-    """Upper triangle of a P2 plane-elasticity stiffness on the top face's triangles, the dofs over `held_xy_m` held."""
-    z = points_mm[:, 2]
-    top = boundary_faces[np.all(np.isclose(z[boundary_faces], z.max()), axis=1)]
-    used = np.unique(top)
-    index = np.full(len(points_mm), -1)
-    index[used] = np.arange(len(used))
-    mesh = skfem.MeshTri(np.ascontiguousarray(points_mm[used, :2].T * MM), np.ascontiguousarray(index[top].T))
-    basis = skfem.Basis(mesh, skfem.ElementVector(skfem.ElementTriP2()))
-    k = linear_elasticity(*lame_parameters(youngs_Pa, poisson_ratio)).assemble(basis)
-    near, _ = cKDTree(held_xy_m).query(basis.doflocs.T, distance_upper_bound=1e-9)
-    free = np.flatnonzero(~np.isfinite(near))
-    return sp.triu(k[free][:, free]).tocsr()
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--candidates", default="6x8,8x4", help="beams x thickness (mm), comma-separated")
@@ -73,17 +52,15 @@ def main() -> None:
     table = Table(["design", "model", "dofs", "analysis + factorization (s)", "refactorization (s)",
                    "refactorization against the 3D path mesh's"])
     with tempfile.TemporaryDirectory() as d:
-        for name in args.candidates.split(","):
-            beams, thickness = name.split("x")
-            checked, part = study.check(study.candidate(beam_count=int(beams), beam_thickness_mm=float(thickness)))
-            mesh = tetrahedralize(study, checked, part, Cache(Path(d)), layers=SolverSettings().path_layers)
-            p = path_problem(mesh, study.material.law, PathSettings())
+        for checked, mesh, p in path_meshes(study, args.candidates, Path(d)):
             k3 = p.solid.tangent(np.zeros_like(p.solid.mesh.nodes_m), p.system.pattern).matrix()
-            held = p.solid.mesh.nodes_m[p.drive.prescribed, :2]
-            k2 = section_stiffness(mesh.points_mm, mesh.boundary_faces, held, study.material.youngs_modulus_Pa,
-                                   study.material.poisson_ratio)
+            nodes, m = p.solid.mesh.nodes_m, study.material
+            section = Section(mesh.points_mm, mesh.boundary_faces, nodes[p.drive.hub, :2], nodes[p.drive.ring, :2],
+                              m.law.shear_modulus_Pa)
+            k2 = linear_elasticity(*lame_parameters(m.youngs_modulus_Pa, m.poisson_ratio)).assemble(section.basis)
+            k2 = sp.triu(k2[section.free][:, section.free]).tocsr()
             solid, plane = timed(k3, args.repeats), timed(k2, args.repeats)
-            label = f"{beams} beams x {thickness} mm"
+            label = checked.name
             table.add(label, f"3D path mesh ({len(mesh.tets)} P2 tetrahedra)", k3.shape[0], f"{solid[0]:.3f}",
                       f"{solid[1]:.3f}", "1")
             table.add(label, "plane section (P2 triangles of its top face)", k2.shape[0], f"{plane[0]:.3f}",

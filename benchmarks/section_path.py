@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -28,11 +29,13 @@ from scipy.spatial import cKDTree
 from skfem.helpers import ddot, det, grad, inv, mul, transpose
 from skfem.models.elasticity import linear_elasticity
 
-from seadesign.design.study import load_study
+from seadesign.design.candidate import Candidate
+from seadesign.design.study import Study, load_study
 from seadesign.fea.pardiso import Pardiso
-from seadesign.fea.rotation_path import PathSettings, path_problem, rotation_path
+from seadesign.fea.rotation_path import PathProblem, PathSettings, path_problem, rotation_path
 from seadesign.fea.torsion import MM
 from seadesign.run.cache import Cache
+from seadesign.mesh.tetmesh import TetMesh
 from seadesign.sweep.stages import SolverSettings, tetrahedralize
 
 ROTATION_CHECK_RAD = 1e-4  # the small rotation of the forms' check against linear plane stress
@@ -141,6 +144,16 @@ class Section:
         return self.torque(np.zeros_like(u), k @ u)
 
 
+def path_meshes(study: Study, candidates: str, folder: Path) -> Iterator[tuple[Candidate, TetMesh, PathProblem]]:
+    """Each candidate of "BEAMSxTHICKNESS,..." (mm) checked, its sweep's path mesh (meshed into `folder`), and the
+    parts of its path without contact."""
+    for name in candidates.split(","):
+        beams, thickness = name.split("x")
+        checked, part = study.check(study.candidate(beam_count=int(beams), beam_thickness_mm=float(thickness)))
+        mesh = tetrahedralize(study, checked, part, Cache(folder), layers=SolverSettings().path_layers)
+        yield checked, mesh, path_problem(mesh, study.material.law, PathSettings())
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--candidates", default="8x4,6x8", help="beams x thickness (mm), comma-separated")
@@ -152,11 +165,7 @@ def main() -> None:
                    "thickness matched / part's", "section against 3D at " + " / ".join(f"{r:g}" for r in COMPARED_RAD)
                    + " rad", "at the 3D path's last point (rad: difference)"])
     with tempfile.TemporaryDirectory() as d:
-        for name in args.candidates.split(","):
-            beams, thickness = name.split("x")
-            checked, part = study.check(study.candidate(beam_count=int(beams), beam_thickness_mm=float(thickness)))
-            mesh = tetrahedralize(study, checked, part, Cache(Path(d)), layers=SolverSettings().path_layers)
-            p = path_problem(mesh, law, PathSettings())
+        for checked, mesh, p in path_meshes(study, args.candidates, Path(d)):
             nodes = p.solid.mesh.nodes_m
             section = Section(mesh.points_mm, mesh.boundary_faces, nodes[p.drive.hub, :2], nodes[p.drive.ring, :2],
                               law.shear_modulus_Pa)
