@@ -31,6 +31,7 @@ from skfem.models.elasticity import linear_elasticity
 
 from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study, load_study
+from seadesign.fea.hub_rotation import HubRotation, moment_z
 from seadesign.fea.pardiso import Pardiso
 from seadesign.fea.rotation_path import PathProblem, PathSettings, path_problem, rotation_path
 from seadesign.fea.torsion import MM
@@ -94,13 +95,13 @@ class Section:
         self.hub, self.ring = over(hub_xy_m), over(ring_xy_m)
         self.free = np.setdiff1d(np.arange(self.basis.N), np.concatenate([self.hub.ravel(), self.ring.ravel()]))
         self.hub_xy = self.basis.doflocs[:, self.hub[:, 0]].T
+        hub_nodes = np.column_stack([self.hub_xy, np.zeros(len(self.hub_xy))])
+        self.drive = HubRotation(hub_nodes, np.arange(len(hub_nodes)), np.array([], dtype=int))  # the hub's motion
 
     def with_hub(self, u: np.ndarray, theta: float) -> np.ndarray:
         """u with the hub turned by theta (rad) and the ring held."""
         u = u.copy()
-        c, s = np.cos(theta), np.sin(theta)
-        x, y = self.hub_xy.T
-        u[self.hub[:, 0]], u[self.hub[:, 1]] = (c - 1) * x - s * y, s * x + (c - 1) * y
+        u[self.hub] = self.drive.displacement(theta)[:, :2]
         u[self.ring.ravel()] = 0.0
         return u
 
@@ -109,8 +110,7 @@ class Section:
 
     def torque(self, u: np.ndarray, f: np.ndarray) -> float:
         """The hub's reaction torque per unit thickness (Nm/m)."""
-        x, y = (self.hub_xy + u[self.hub]).T
-        return float(np.sum(x * f[self.hub[:, 1]] - y * f[self.hub[:, 0]]))
+        return moment_z(self.hub_xy + u[self.hub], f[self.hub])
 
     def solve(self, guess: np.ndarray, theta: float, rtol: float = 1e-9) -> tuple[np.ndarray, np.ndarray, int]:
         """Equilibrium at the hub rotation theta (rad) by Newton from `guess` with a backtracking line search;
