@@ -14,7 +14,7 @@ from functools import cached_property
 import numpy as np
 
 from seadesign.design.materials import Hyperelastic
-from seadesign.fea.kernels import det_inverse_transpose
+from seadesign.fea.kernels import det_inverse_transpose, mooney_rivlin_tangent
 
 _I = np.eye(3)
 
@@ -159,10 +159,18 @@ def i1_tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None 
                      (2 / 3) * s * I1 - wj * J, w11)
 
 
+def _points(x, shape: tuple[int, ...]) -> np.ndarray:
+    """A field over the points `shape` (scalar or with trailing (3, 3)) as a contiguous float array, points flattened."""
+    x = np.asarray(x, dtype=float)
+    tail = x.shape[len(shape):] if x.ndim > len(shape) else ()
+    return np.ascontiguousarray(np.broadcast_to(x, shape + tail)).reshape((-1,) + tail)
+
+
 def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """P (..., 3, 3) and A = dP/dF (..., 3, 3, 3, 3) with A[..., i, J, k, L] = dP_iJ / dF_kL (Pa).
     With `pressure_Pa` (U' given, as in `stress`), U'' is left out: the caller adds the volumetric stiffness.
-    Laws without I2bar are built from `i1_tangent`; Mooney-Rivlin from the second derivatives of both invariants."""
+    Laws without I2bar are built from `i1_tangent`; Mooney-Rivlin from the second derivatives of both invariants, in
+    one compiled pass per point (`fea.kernels.mooney_rivlin_tangent`)."""
     if not law.c01_Pa:
         t = i1_tangent(law, F, pressure_Pa)
         return t.P, t.full()
@@ -170,32 +178,8 @@ def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = N
     (i1b, d1), (_, d2) = _first(kin), _second(kin)
     (w1, w11), w2 = _isochoric(law, i1b), law.c01_Pa
     wj, wjj = _volumetric_slopes(law, kin.J, pressure_Pa)
-    F, H, J, I1, I2 = kin.F, kin.H, kin.J, kin.I1, kin.I2
-    e, e4 = (..., None, None), (..., None, None, None, None)
-    hh = _outer(H, H)  # H_iJ H_kL
-    hx = np.swapaxes(hh, -3, -1)  # H_iL H_kJ
-    ii = np.broadcast_to(np.einsum("ik,JL->iJkL", _I, _I), F.shape[:-2] + (3, 3, 3, 3))
-
-    # d2 I1bar / dF2
-    j23 = J ** (-2 / 3)
-    dd1 = j23[e4] * (
-        -(2 / 3) * _outer(2.0 * F - (2 / 3) * I1[e] * H, H)
-        + 2.0 * ii - (4 / 3) * _outer(H, F) + (2 / 3) * I1[e4] * hx
-    )
-    P = w1[e] * d1 + (wj * J)[e] * H + w2 * d2  # the order of `stress`: the same P to the last bit
-    a = w11[e4] * _outer(d1, d1) + w1[e4] * dd1
-    if w2:
-        # d2 I2 / dF2 = 2 (2 F_kL F_iJ + I1 d_ik d_JL - d_ik C_LJ - F_iL F_kJ - b_ik d_JL), b = F F^T
-        b = F @ np.swapaxes(F, -1, -2)
-        ff = _outer(F, F)
-        ddi2 = 2.0 * (2.0 * ff + I1[e4] * ii - np.einsum("ik,...LJ->...iJkL", _I, kin.C)
-                      - np.swapaxes(ff, -3, -1) - np.einsum("...ik,JL->...iJkL", b, _I))
-        j43 = J ** (-4 / 3)
-        dd2 = j43[e4] * (
-            -(4 / 3) * _outer(kin.dI2 - (4 / 3) * I2[e] * H, H)
-            + ddi2 - (4 / 3) * _outer(H, kin.dI2) + (4 / 3) * I2[e4] * hx
-        )
-        a = a + w2 * dd2
-    # d/dF (dW/dJ J H) = (d2W/dJ2 J^2 + dW/dJ J) H x H - dW/dJ J H_iL H_kJ
-    a = a + (wjj * J**2 + wj * J)[e4] * hh - (wj * J)[e4] * hx
-    return P, a
+    e = (..., None, None)
+    P = w1[e] * d1 + (wj * kin.J)[e] * kin.H + w2 * d2  # the order of `stress`: the same P to the last bit
+    fields = (kin.F, kin.H, kin.J, kin.I1, kin.I2, w1, w11, w2, wjj * kin.J**2 + wj * kin.J, wj * kin.J)
+    a = mooney_rivlin_tangent(*(_points(x, kin.J.shape) for x in fields))
+    return P, a.reshape(F.shape[:-2] + (3, 3, 3, 3))

@@ -99,6 +99,51 @@ def general_pair_blocks(dlam: np.ndarray, gamma: np.ndarray, weights: np.ndarray
 
 
 @njit(cache=True, nogil=True)
+def mooney_rivlin_tangent(F: np.ndarray, H: np.ndarray, J: np.ndarray, I1: np.ndarray, I2: np.ndarray, w1: np.ndarray,
+                          w11: np.ndarray, w2: np.ndarray, vhh: np.ndarray, vhx: np.ndarray) -> np.ndarray:
+    """A = dP/dF (n, 3, 3, 3, 3), A[iJkL] = dP_iJ / dF_kL (Pa), of W(I1bar, I2bar, J) linear in I2bar at each F (n, 3, 3)
+    (H = F^-T, J, I1 = tr C, I2 = I2(C)): w11 dI1b x dI1b + w1 d2I1b + w2 d2I2b + vhh H_iJ H_kL - vhx H_iL H_kJ, with
+    w1 = dW/dI1bar, w11 = d2W/dI1bar2, w2 = dW/dI2bar (Pa) and the volumetric vhh = U'' J^2 + U' J, vhx = U' J (Pa);
+    d2I1b = J^-2/3 (-2/3 (2 F - 2/3 I1 H) x H + 2 d_ik d_JL - 4/3 H x F + 2/3 I1 H_iL H_kJ),
+    d2I2b = J^-4/3 (-4/3 (dI2 - 4/3 I2 H) x H + d2I2 - 4/3 H x dI2 + 4/3 I2 H_iL H_kJ),
+    d2I2 = 2 (2 F_iJ F_kL + I1 d_ik d_JL - d_ik C_LJ - F_iL F_kJ - b_ik d_JL), dI2 = 2 (I1 F - F C), b = F F^T."""
+    n = F.shape[0]
+    out = np.empty((n, 3, 3, 3, 3))
+    c, b, di2 = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
+    x, y, d1 = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
+    for e in range(n):
+        f, h = F[e], H[e]
+        j23, j43 = J[e] ** (-2.0 / 3.0), J[e] ** (-4.0 / 3.0)
+        i1, i2 = I1[e], I2[e]
+        for r in range(3):
+            for s in range(3):
+                c[r, s] = f[0, r] * f[0, s] + f[1, r] * f[1, s] + f[2, r] * f[2, s]
+                b[r, s] = f[r, 0] * f[s, 0] + f[r, 1] * f[s, 1] + f[r, 2] * f[s, 2]
+        for r in range(3):
+            for s in range(3):
+                fc = f[r, 0] * c[0, s] + f[r, 1] * c[1, s] + f[r, 2] * c[2, s]
+                di2[r, s] = 2.0 * (i1 * f[r, s] - fc)
+                x[r, s] = 2.0 * f[r, s] - (2.0 / 3.0) * i1 * h[r, s]
+                y[r, s] = di2[r, s] - (4.0 / 3.0) * i2 * h[r, s]
+                d1[r, s] = j23 * x[r, s]
+        for i in range(3):
+            for jj in range(3):
+                for k in range(3):
+                    for L in range(3):
+                        dik, djl = 1.0 if i == k else 0.0, 1.0 if jj == L else 0.0
+                        hx = h[i, L] * h[k, jj]
+                        dd1 = j23 * (-(2.0 / 3.0) * x[i, jj] * h[k, L] + 2.0 * dik * djl - (4.0 / 3.0) * h[i, jj] * f[k, L]
+                                     + (2.0 / 3.0) * i1 * hx)
+                        ddi2 = 2.0 * (2.0 * f[i, jj] * f[k, L] + i1 * dik * djl - dik * c[L, jj] - f[i, L] * f[k, jj]
+                                      - b[i, k] * djl)
+                        dd2 = j43 * (-(4.0 / 3.0) * y[i, jj] * h[k, L] + ddi2 - (4.0 / 3.0) * h[i, jj] * di2[k, L]
+                                     + (4.0 / 3.0) * i2 * hx)
+                        out[e, i, jj, k, L] = (w11[e] * d1[i, jj] * d1[k, L] + w1[e] * dd1 + w2[e] * dd2
+                                               + vhh[e] * h[i, jj] * h[k, L] - vhx[e] * hx)
+    return out
+
+
+@njit(cache=True, nogil=True)
 def deformation_gradients(dlam: np.ndarray, gamma: np.ndarray, elements: np.ndarray, u: np.ndarray) -> np.ndarray:
     """F = I + sum_a u_a G_a^T (m, q, 3, 3) at the quadrature points; elements (m, nen), u (N, 3) in m."""
     m, nq, nen = gamma.shape[0], dlam.shape[0], dlam.shape[1]
