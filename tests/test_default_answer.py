@@ -73,6 +73,42 @@ def test_the_default_study_answer_and_its_handoff(tmp_path):
     assert "curve ends at 0.229 rad, 7.099 Nm" in result["settings"]["feedforward_not_judged"]
 
 
+
+@pytest.mark.long
+def test_the_default_spring_handed_on_through_contact_trains_and_evaluates(tmp_path):
+    """The chain past the refusal above, as its remedy says: `sweep --handoff-through-contact` (the default sweep's
+    rows from the stage cache, then the chosen design's path through frictionless self-contact, about 25 minutes on
+    2 cores: CI's budget cannot hold it, hence `long`), `train` with reduced epoch limits on its spring.json, with and
+    without the reference recordings, and `evaluate` of what it trained in the simulator's closed loop. The curve
+    now reaches past every load of the simulator's protocol, so training completes where the plain sweep's spring is
+    refused, and the trained corrector holds the knee closer than no correction in both settings."""
+    from seadesign.corrector.preflight import check_spring_range
+
+    out = tmp_path / "exports"
+    swept = CliRunner().invoke(main, ["sweep", "--quiet", "--handoff-through-contact", "--out", str(out)])
+    assert swept.exit_code == 0, swept.output
+    spring_path = out / "wolfgang_knee" / "spring.json"
+    spring = json.loads(spring_path.read_text())
+    assert spring["selection"]["candidate"] == "6 beams x 8 mm" and spring["torque_curve"]["stop_reason"] != "contact"
+    check_spring_range(spring)  # the protocol's loads are on the curve: no refusal
+    data = [arg for path in RECORDINGS if path.exists() for arg in ("--data", str(path))]
+    for name, extra in [("simulator", []), ("recordings", data)][: 2 if data else 1]:
+        bundle = tmp_path / name
+        trained = CliRunner().invoke(main, ["train", "--spring", str(spring_path), "--max-epochs", "2", "-o",
+                                            str(bundle), *extra])
+        assert trained.exit_code == 0, trained.output
+        report = tmp_path / f"{name}.json"
+        evaluated = CliRunner().invoke(main, ["evaluate", str(bundle), *extra, "--trial-s", "4", "-o",
+                                              str(tmp_path / f"{name}-eval"), "--json", str(report)])
+        assert evaluated.exit_code == 0, evaluated.output
+        rows = pd.DataFrame(json.loads(report.read_text())["closed_loop"])
+        for setting, table in rows.groupby("setting"):
+            error = table.set_index("candidate")["mean_abs_error_rad"]
+            trained_error = error[[c for c in error.index if c.startswith("closedloop")]]
+            assert len(trained_error) == 1 and trained_error.iloc[0] < error["none"], (name, setting, error)
+    if not data:
+        pytest.skip(f"train with --data: the reference recordings are not present ({RECORDINGS[0].parent})")
+
 def _documented_calibration_lines() -> list[str]:
     """The printed lines of the worked calibration in docs/explanation/calibration.md (its block starting "calibration:")."""
     page = (Path(__file__).resolve().parents[1] / "docs" / "explanation" / "calibration.md").read_text()
