@@ -78,10 +78,11 @@ def test_the_default_study_answer_and_its_handoff(tmp_path):
 def test_the_default_spring_handed_on_through_contact_trains_and_evaluates(tmp_path):
     """The chain past the refusal above, as its remedy says: `sweep --handoff-through-contact` (the default sweep's
     rows from the stage cache, then the chosen design's path through frictionless self-contact, about 25 minutes on
-    2 cores: CI's budget cannot hold it, hence `long`), `train` with reduced epoch limits on its spring.json, with and
-    without the reference recordings, and `evaluate` of what it trained in the simulator's closed loop. The curve
-    now reaches past every load of the simulator's protocol, so training completes where the plain sweep's spring is
-    refused, and the trained corrector holds the knee closer than no correction in both settings."""
+    2 cores: CI's budget cannot hold it, hence `long`), `train` with its time capped (30 s a stage) on its
+    spring.json, with and without the reference recordings, and `evaluate` of what it trained in the simulator's
+    closed loop (about 3 minutes a case). The curve now reaches past every load of the simulator's protocol, so
+    training completes where the plain sweep's spring is refused, and the trained corrector is stable and holds the
+    knee at less than half the error of the best baseline (no correction, PI, feed-forward) in both settings."""
     from seadesign.corrector.preflight import check_spring_range
 
     out = tmp_path / "exports"
@@ -89,12 +90,14 @@ def test_the_default_spring_handed_on_through_contact_trains_and_evaluates(tmp_p
     assert swept.exit_code == 0, swept.output
     spring_path = out / "wolfgang_knee" / "spring.json"
     spring = json.loads(spring_path.read_text())
-    assert spring["selection"]["candidate"] == "6 beams x 8 mm" and spring["torque_curve"]["stop_reason"] != "contact"
+    design, curve = spring["design"], spring["torque_curve"]
+    assert (design["beam_count"], design["beam_thickness_mm"]) == (6, 8.0) and curve["stop_reason"] != "contact"
+    assert "frictionless self-contact" in spring["selection"]["curve"]
     check_spring_range(spring)  # the protocol's loads are on the curve: no refusal
     data = [arg for path in RECORDINGS if path.exists() for arg in ("--data", str(path))]
     for name, extra in [("simulator", []), ("recordings", data)][: 2 if data else 1]:
         bundle = tmp_path / name
-        trained = CliRunner().invoke(main, ["train", "--spring", str(spring_path), "--max-epochs", "2", "-o",
+        trained = CliRunner().invoke(main, ["train", "--spring", str(spring_path), "--max-seconds", "30", "-o",
                                             str(bundle), *extra])
         assert trained.exit_code == 0, trained.output
         report = tmp_path / f"{name}.json"
@@ -102,10 +105,11 @@ def test_the_default_spring_handed_on_through_contact_trains_and_evaluates(tmp_p
                                               str(tmp_path / f"{name}-eval"), "--json", str(report)])
         assert evaluated.exit_code == 0, evaluated.output
         rows = pd.DataFrame(json.loads(report.read_text())["closed_loop"])
-        for setting, table in rows.groupby("setting"):
-            error = table.set_index("candidate")["mean_abs_error_rad"]
-            trained_error = error[[c for c in error.index if c.startswith("closedloop")]]
-            assert len(trained_error) == 1 and trained_error.iloc[0] < error["none"], (name, setting, error)
+        for setting, table in rows.groupby("setting"):  # measured 0.008 / 0.012 rad against 0.053 / 0.091 at best
+            table = table.set_index("candidate")
+            error, ours = table["mean_abs_error_rad"], [c for c in table.index if c.startswith("closedloop")]
+            assert len(ours) == 1 and table.loc[ours[0], "stable"], (name, setting, table)
+            assert error[ours[0]] < 0.5 * error[["none", "pi", "feedforward"]].min(), (name, setting, error)
     if not data:
         pytest.skip(f"train with --data: the reference recordings are not present ({RECORDINGS[0].parent})")
 
