@@ -161,22 +161,33 @@ def test_cache_hit_and_load_change_reuses_the_solve(tiny, tmp_path):
 
 
 @pytest.mark.slow
-def test_a_modulus_change_reuses_the_mesh_and_the_linear_solves(tiny, tmp_path):
-    """A calibration that changes only the modulus solves the paths again but neither the mesh nor the linear
-    solves; the rows follow linear elasticity at a fixed Poisson ratio: k and the coarse k as E, the rotation as
-    1 / E, the stresses unchanged."""
+def test_a_modulus_change_reuses_the_mesh_the_linear_solves_and_the_path(tiny, tmp_path):
+    """A calibration that changes only the modulus solves neither the mesh nor the linear solves again; the rows
+    follow linear elasticity at a fixed Poisson ratio: k and the coarse k as E, the rotation as 1 / E, the stresses
+    unchanged. A softer part's path is the uncalibrated one scaled (the same solve's time: nothing solved again),
+    and reads as the path solved under the scaled law in a cache of its own does."""
+    from dataclasses import replace
+
     study_path, cache_dir, _ = tiny
     s = load_study(study_path)
     base = run_sweep(s, tmp_path / "a", cache=Cache(cache_dir), jobs=1, quiet=True).rows.loc[0]
-    meshes, linear, paths = (set((cache_dir / stage).rglob("*")) for stage in ("tetmesh", "fea", "path"))
-    stiff = s.with_materials({s.material.key: s.material.scaled(2.0, "test")})
-    r = run_sweep(stiff, tmp_path / "b", cache=Cache(cache_dir), jobs=1, quiet=True).rows.loc[0]
+    meshes, linear = (set((cache_dir / stage).rglob("*")) for stage in ("tetmesh", "fea"))
+    soft = s.material.scaled(0.45, "test")
+    r = run_sweep(s.with_materials({s.material.key: soft}), tmp_path / "b", cache=Cache(cache_dir), jobs=1,
+                  quiet=True).rows.loc[0]
     assert meshes and set((cache_dir / "tetmesh").rglob("*")) == meshes and set((cache_dir / "fea").rglob("*")) == linear
-    assert r["k_Nm_per_rad"] == pytest.approx(2 * base["k_Nm_per_rad"], rel=1e-14)
-    assert r["k_coarse_Nm_per_rad"] == pytest.approx(2 * base["k_coarse_Nm_per_rad"], rel=1e-14)
-    assert r["stall_rotation_rad"] == pytest.approx(base["stall_rotation_rad"] / 2, rel=1e-14)
+    assert r["k_Nm_per_rad"] == pytest.approx(0.45 * base["k_Nm_per_rad"], rel=1e-14)
+    assert r["k_coarse_Nm_per_rad"] == pytest.approx(0.45 * base["k_coarse_Nm_per_rad"], rel=1e-14)
+    assert r["stall_rotation_rad"] == pytest.approx(base["stall_rotation_rad"] / 0.45, rel=1e-14)
     assert r["stall_von_mises_max_MPa"] == base["stall_von_mises_max_MPa"]
-    assert set((cache_dir / "path").rglob("*")) > paths  # the path is solved again
+    assert r["large_stop_reason"] == base["large_stop_reason"] != "target_reached"
+    assert r["large_time_s"] == base["large_time_s"]  # the uncalibrated solve's: scaled, not solved again
+    solved = run_sweep(s.with_materials({s.material.key: replace(soft, scaled_from=None)}), tmp_path / "c",
+                       cache=Cache(tmp_path / "own-cache"), jobs=1, quiet=True).rows.loc[0]
+    assert solved["large_time_s"] != base["large_time_s"]
+    for column in ("large_stop_rotation_rad", "large_stop_torque_Nm", "large_contact_torque_Nm",
+                   "large_peak_tensile_strain", "large_standing_rotation_rad", "large_standing_tensile_strain"):
+        assert r[column] == pytest.approx(solved[column], rel=1e-10), column
 
 
 def test_a_rerun_takes_the_cad_files_from_the_stage_cache(tiny, tmp_path, monkeypatch):

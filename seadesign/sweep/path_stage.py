@@ -5,11 +5,17 @@ torque or to where it stops, on the result mesh's in-plane sizing with `SolverSe
 layers through the thickness (its error against the result mesh is in docs/validation/mesh-convergence.md). `fea.large_deflection`
 reads it at the standing, stall and impact torques. The result is cached under the mesh, the law,
 the path settings, the torques, the strain limits, the end-stop rule and the code.
+
+A material calibrated by a stiffness scale (`Material.scaled`) takes the path of the material it was scaled from,
+scaled (`fea.path_scale`: the same equilibria, the torques times the scale), wherever that path serves: it did not
+stop at its own impact torque before the scaled curve reaches the study's, and its render's state is the scaled
+path's. Elsewhere the path is solved under the scaled law. Either way the answer depends on the inputs only,
+not on what the cache holds.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
@@ -18,7 +24,9 @@ from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.large_deflection import LargeDeflection, large_deflection
+from seadesign.fea.path_scale import scaled_path
 from seadesign.fea.rotation_path import PathSettings, rotation_path, through_contact
+from seadesign.fea.torque_path import TorquePath
 from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.fingerprint import code_fingerprint
 from seadesign.sweep.stages import Progress, SolverSettings, mesh_key, tetrahedralize
@@ -39,6 +47,7 @@ class PathResponse:
     vertex_strain: np.ndarray  # (n,) largest tensile principal engineering strain of the elements at each vertex
     snapshot_rotation_rad: float
     snapshot_torque_Nm: float
+    path: TorquePath  # the path's points, stop and events, without its states (what a scaled law reads again)
 
 
 def path_settings(study: Study) -> PathSettings:
@@ -63,6 +72,34 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     hit = cache.get("path", key)
     if hit is not None:
         return hit
+    response = _scaled_response(study, candidate, part, settings, cache, progress)
+    if response is None:
+        response = _solved_response(study, candidate, part, settings, cache, progress)
+    cache.put("path", key, response)
+    return response
+
+
+def _scaled_response(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings,
+                     cache: Cache, progress: Progress) -> PathResponse | None:
+    """The path of the material `candidate.material` was scaled from, scaled, where it serves (module doc)."""
+    base = candidate.material.scaled_from
+    s = None if base is None else candidate.material.law.scale_of(base.law)
+    if s is None:
+        return None
+    source = path_response(study, replace(candidate, material=base), part, settings, cache, progress)
+    lc = study.load_cases
+    path = scaled_path(source.path, s, lc.impact_torque_Nm, path_settings(study).contact_gap_mm, lc.stall_torque_Nm)
+    if path is None:
+        return None
+    result = large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
+                              candidate.material.strain_limits(study.ranking.safety_factor),
+                              study.ranking.contact_is_end_stop)
+    return replace(source, result=result, snapshot_torque_Nm=path.points[path.snapshot_index].torque_Nm, path=path)
+
+
+def _solved_response(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings,
+                     cache: Cache, progress: Progress) -> PathResponse:
+    """The candidate's path solved on the path mesh and read at the loads."""
     progress("mesh")
     mesh = tetrahedralize(study, candidate, part(), cache, layers=settings.path_layers)
     progress("path")
@@ -77,7 +114,6 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     vertex_strain = np.zeros(nv)
     np.maximum.at(vertex_strain, mesh.tets, tensile[:, None])
     shot = path.points[path.snapshot_index]
-    response = PathResponse(result, mesh.points_mm, mesh.tets, path.snapshot_displacement_m[:nv], vertex_strain,
-                            shot.rotation_rad, shot.torque_Nm)
-    cache.put("path", key, response)
-    return response
+    return PathResponse(result, mesh.points_mm, mesh.tets, path.snapshot_displacement_m[:nv], vertex_strain,
+                        shot.rotation_rad, shot.torque_Nm,
+                        replace(path, displacement_m=None, snapshot_displacement_m=None))
