@@ -60,6 +60,16 @@ def test_a_stiffer_law_stops_at_the_target_where_its_own_path_does(plate):
     assert scaled.displacement_m is None  # cut short: its last state is not the base path's
 
 
+def test_a_path_cut_at_the_target_is_the_path_solved_to_the_target_over_the_scale_to_the_last_digit(plate):
+    mesh, base = plate
+    target, s = 1.2 * base.stop_torque_Nm, 2.3
+    short = rotation_path(mesh, LAW, target / s, SETTINGS)
+    assert short.stop_reason == "target_reached" and len(short.points) < len(base.points)
+    a, b = (scaled_path(p, s, target, SETTINGS.contact_gap_mm) for p in (base, short))
+    assert repr((a.points, a.stop_reason, a.stop_rotation_rad, a.stop_torque_Nm, a.events)) == \
+        repr((b.points, b.stop_reason, b.stop_rotation_rad, b.stop_torque_Nm, b.events))  # floats by repr: exact, NaN too
+
+
 def test_a_softer_law_cannot_read_a_path_that_stopped_at_its_target(plate):
     mesh, base = plate
     short = rotation_path(mesh, LAW, 0.5 * base.stop_torque_Nm, SETTINGS)

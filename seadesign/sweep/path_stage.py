@@ -6,11 +6,11 @@ layers through the thickness (its error against the result mesh is in docs/valid
 reads it at the standing, stall and impact torques. The result is cached under the mesh, the law,
 the path settings, the torques, the strain limits, the end-stop rule and the code.
 
-A material calibrated by a stiffness scale (`Material.scaled`) takes the path of the material it was scaled from,
-scaled (`fea.path_scale`: the same equilibria, the torques times the scale), wherever that path serves: it did not
-stop at its own impact torque before the scaled curve reaches the study's, and its render's state is the scaled
-path's. Elsewhere the path is solved under the scaled law. Either way the answer depends on the inputs only,
-not on what the cache holds.
+A material calibrated by a stiffness scale s (`Material.scaled`) has the path of the material it was scaled
+from driven to the loads over s, its torques times s (`fea.path_scale`): read from that material's path when the
+cache holds it and its points are those (it stopped before its impact torque for a reason no scale moves, and its
+render's state is the same point), else solved. Either way the numbers are the same to the last digit: they depend
+on the inputs only, not on what the cache holds.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from seadesign.design.candidate import Candidate
+from seadesign.design.materials import Hyperelastic
 from seadesign.design.study import Study
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.large_deflection import LargeDeflection, large_deflection
@@ -72,43 +73,42 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     hit = cache.get("path", key)
     if hit is not None:
         return hit
-    response = _scaled_response(study, candidate, part, settings, cache, progress)
-    if response is None:
-        response = _solved_response(study, candidate, part, settings, cache, progress)
+    base, s = candidate.material, 1.0
+    if base.scaled_from is not None and base.law.scale_of(base.scaled_from.law) is not None:
+        base, s = base.scaled_from, base.law.scale_of(base.scaled_from.law)
+    lc, gap = study.load_cases, path_settings(study).contact_gap_mm
+    unscaled = None if s == 1.0 else cache.get("path", path_key(study, replace(candidate, material=base), settings))
+    path = None if unscaled is None else scaled_path(unscaled.path, s, lc.impact_torque_Nm, gap, lc.stall_torque_Nm)
+    if path is not None:  # the uncalibrated path's points are this one's
+        response = replace(unscaled, result=_read(study, candidate, path),
+                           snapshot_torque_Nm=path.points[path.snapshot_index].torque_Nm, path=path)
+    else:
+        response = _solved_response(study, candidate, base.law, s, part, settings, cache, progress)
     cache.put("path", key, response)
     return response
 
 
-def _scaled_response(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings,
-                     cache: Cache, progress: Progress) -> PathResponse | None:
-    """The path of the material `candidate.material` was scaled from, scaled, where it serves (module doc)."""
-    base = candidate.material.scaled_from
-    s = None if base is None else candidate.material.law.scale_of(base.law)
-    if s is None:
-        return None
-    source = path_response(study, replace(candidate, material=base), part, settings, cache, progress)
+def _read(study: Study, candidate: Candidate, path: TorquePath) -> LargeDeflection:
+    """The path read at the study's loads."""
     lc = study.load_cases
-    path = scaled_path(source.path, s, lc.impact_torque_Nm, path_settings(study).contact_gap_mm, lc.stall_torque_Nm)
-    if path is None:
-        return None
-    result = large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
-                              candidate.material.strain_limits(study.ranking.safety_factor),
-                              study.ranking.contact_is_end_stop)
-    return replace(source, result=result, snapshot_torque_Nm=path.points[path.snapshot_index].torque_Nm, path=path)
+    return large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
+                            candidate.material.strain_limits(study.ranking.safety_factor),
+                            study.ranking.contact_is_end_stop)
 
 
-def _solved_response(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings,
-                     cache: Cache, progress: Progress) -> PathResponse:
-    """The candidate's path solved on the path mesh and read at the loads."""
+def _solved_response(study: Study, candidate: Candidate, law: Hyperelastic, s: float, part: Callable[[], Part],
+                     settings: SolverSettings, cache: Cache, progress: Progress) -> PathResponse:
+    """The candidate's path solved on the path mesh under `law` times `s` (`law` driven to the loads over s)."""
     progress("mesh")
     mesh = tetrahedralize(study, candidate, part(), cache, layers=settings.path_layers)
     progress("path")
-    lc, m = study.load_cases, candidate.material
-    path = rotation_path(mesh, m.law, lc.impact_torque_Nm, path_settings(study), order=settings.element_order,
-                         formulation=settings.path_formulation, snapshot_torque_Nm=lc.stall_torque_Nm)
-    result = large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
-                              m.strain_limits(study.ranking.safety_factor), study.ranking.contact_is_end_stop)
-    tensile = Solid.of(path.emesh, m.law, settings.path_formulation).element_strain_stress(
+    lc = study.load_cases
+    path = rotation_path(mesh, law, lc.impact_torque_Nm / s, path_settings(study), order=settings.element_order,
+                         formulation=settings.path_formulation, snapshot_torque_Nm=lc.stall_torque_Nm / s)
+    if s != 1.0:  # serves by construction: driven to the loads over s
+        path = scaled_path(path, s, lc.impact_torque_Nm, path_settings(study).contact_gap_mm, lc.stall_torque_Nm)
+    result = _read(study, candidate, path)
+    tensile = Solid.of(path.emesh, law, settings.path_formulation).element_strain_stress(
         path.snapshot_displacement_m).tensile_strain
     nv = len(mesh.points_mm)
     vertex_strain = np.zeros(nv)
