@@ -9,7 +9,8 @@ large-deflection path on the sweep's path mesh (the same sizing with SolverSetti
 through the thickness; fea.rotation_path, to the stall torque or where it stops, no strain stop):
 its time split into assembly / factorization / solve / stop checks (the solver's methods timed from
 here, the library unchanged), Newton iterations per increment, one assembly of the residual and the
-tangent at the path's last state against scikit-fem's assembly of the same law (tests/helpers_skfem.py),
+tangent at the path's last state against scikit-fem's assembly of the same law (tests/helpers_skfem.py) and
+under the calibration's Yeoh and Mooney-Rivlin trial laws,
 and CalculiX NLGEOM on the same mesh and rotations with the time ratio and the torque agreement. --coarsening C makes every mesh size C
 times coarser, as the sweep's error-estimate mesh (C = 4: a few minutes in all).
 """
@@ -201,6 +202,7 @@ def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool, contact:
     print(f"{'other (set-up, predictor, bookkeeping)':<44}{other:>9.2f}")
     print(f"{'path total':<44}{path.time_s:>9.2f}")
     assembly_vs_skfem(mesh, law, path.displacement_m)
+    assembly_by_law(mesh, law, path.displacement_m)
     if not use_ccx:
         return
     theta = [p.rotation_rad for p in points]
@@ -247,6 +249,27 @@ def assembly_vs_skfem(mesh, law, u: np.ndarray) -> None:
     print(f"residual + tangent assembly at the last state: ours {times['ours']:.2f} s, scikit-fem "
           f"{times['scikit-fem']:.2f} s (ratio {times['ours'] / times['scikit-fem']:.3f}); largest difference "
           f"{df:.1e} (residual), {dk:.1e} (tangent), relative to the largest entry")
+
+
+
+def assembly_by_law(mesh, law, u: np.ndarray) -> None:
+    """Residual and tangent at u under each law family at the material's mu (the calibration's trial laws: Yeoh
+    through the I1-only kernel, Mooney-Rivlin through `fea.kernels.mooney_rivlin_tangent`), timed after one
+    warm-up call each, against the material's own law in the same process."""
+    from seadesign.calibration.law_family import trial_law
+
+    laws = {"material's": law, "yeoh c20_ratio 0.05": trial_law(law, "yeoh", 0.05),
+            "mooney_rivlin c01_share 0.5": trial_law(law, "mooney_rivlin", 0.5)}
+    times = {}
+    for name, each in laws.items():
+        solid = Solid.of(element_mesh(mesh.points_mm * 1e-3, mesh.tets, 2), each)
+        solid.forces(u), solid.tangent(u)
+        t = time.perf_counter()
+        solid.forces(u), solid.tangent(u)
+        times[name] = time.perf_counter() - t
+    ref = times["material's"]
+    print("residual + tangent assembly by law at the last state: " + ", ".join(
+        f"{name} {t:.2f} s ({t / ref:.2f}x)" for name, t in times.items()))
 
 
 if __name__ == "__main__":

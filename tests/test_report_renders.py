@@ -26,7 +26,7 @@ RENDER = textwrap.dedent("""
     points = np.asarray(block.points, float)
     tets = np.asarray(block.cells_dict[pv.CellType.TETRA])
     twist = np.column_stack([-points[:, 1], points[:, 0], np.zeros(len(points))]) * 1e-5 * points[:, :1]
-    response = PathResponse(None, points, tets, twist, points[:, 0] / 320.0, 0.3, 2.5)
+    response = PathResponse(None, points, tets, twist, points[:, 0] / 320.0, 0.3, 2.5, None)
     written = render_path(response, 0.08, "test block", Path(sys.argv[1]))
     print("written:", written)
 """)

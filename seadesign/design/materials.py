@@ -15,6 +15,7 @@ D1 = 2 / K), so the small-strain limit is exactly the linear model.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -71,6 +72,15 @@ class Hyperelastic:
         """The initial shear modulus mu = 2 (C10 + C01) (Pa)."""
         return 2.0 * (self.c10_Pa + self.c01_Pa)
 
+    def scale_of(self, other: "Hyperelastic") -> float | None:
+        """s where this law is `other` with every modulus times s and every compressibility over s (each to 1e-12
+        relative), else None: a stiffness calibration of `other` (`Material.scaled`)."""
+        s = self.shear_modulus_Pa / other.shear_modulus_Pa
+        pairs = [(getattr(self, f), s * getattr(other, f)) for f in ("c10_Pa", "c01_Pa", "c20_Pa", "c30_Pa")]
+        pairs += [(getattr(self, f), getattr(other, f) / s) for f in ("d1_per_Pa", "d2_per_Pa", "d3_per_Pa")]
+        same = self.model == other.model and all(abs(a - b) <= 1e-12 * max(abs(a), abs(b)) for a, b in pairs)
+        return s if same else None
+
 
 @dataclass(frozen=True)
 class StrainLimits:
@@ -101,6 +111,7 @@ class Material:
     hyperelastic: Hyperelastic | None = None  # None: derived from E and nu (see `law`)
     elongation_at_yield: float | None = None  # engineering strain (0.65 = 65 %); None: no sourced value
     cyclic_strain_limit: float | None = None  # tensile engineering strain for loads repeated millions of times
+    scaled_from: Material | None = dataclasses.field(default=None, repr=False, compare=False)  # the material `scaled` scaled
 
     @property
     def law(self) -> Hyperelastic:
@@ -164,7 +175,8 @@ class Material:
             d1_per_Pa=h.d1_per_Pa / s, d2_per_Pa=h.d2_per_Pa / s, d3_per_Pa=h.d3_per_Pa / s,
             source=f"{h.source}; x {s:.4g} ({note})")
         return replace(self, youngs_modulus_Pa=self.youngs_modulus_Pa * s, name=f"{self.name} ({note})",
-                       sources=tuple(tuple(x) for x in self.sources) + (("youngs_modulus", note),), hyperelastic=hyper)
+                       sources=tuple(tuple(x) for x in self.sources) + (("youngs_modulus", note),), hyperelastic=hyper,
+                       scaled_from=self.scaled_from or self)
 
     def to_handoff(self) -> dict:
         """The material block of spring.json.

@@ -58,7 +58,8 @@ class TorquePath:
     stop_reason: str
     stop_rotation_rad: float
     stop_torque_Nm: float
-    displacement_m: np.ndarray = field(repr=False)  # (N, 3) at the last converged point
+    displacement_m: np.ndarray | None = field(repr=False)  # (N, 3) at the last converged point (None: a path
+    # scaled and cut short, `fea.path_scale`, or kept without its states)
     emesh: ElementMesh = field(repr=False)
     cut_backs: int = 0
     factorizations: int = 0  # tangent factorizations, cut-back attempts included

@@ -5,20 +5,29 @@ torque or to where it stops, on the result mesh's in-plane sizing with `SolverSe
 layers through the thickness (its error against the result mesh is in docs/validation/mesh-convergence.md). `fea.large_deflection`
 reads it at the standing, stall and impact torques. The result is cached under the mesh, the law,
 the path settings, the torques, the strain limits, the end-stop rule and the code.
+
+A material calibrated by a stiffness scale s (`Material.scaled`) has the path of the material it was scaled
+from driven to the loads over s, its torques times s (`fea.path_scale`): read from that material's path when the
+cache holds it and its points are those (it stopped before its impact torque for a reason no scale moves, and its
+render's state is the same point), else solved. Either way the numbers are the same to the last digit: they depend
+on the inputs only, not on what the cache holds.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from seadesign.design.candidate import Candidate
+from seadesign.design.materials import Hyperelastic
 from seadesign.design.study import Study
 from seadesign.fea.finite_strain import Solid
 from seadesign.fea.large_deflection import LargeDeflection, large_deflection
+from seadesign.fea.path_scale import scaled_path
 from seadesign.fea.rotation_path import PathSettings, rotation_path, through_contact
+from seadesign.fea.torque_path import TorquePath
 from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.fingerprint import code_fingerprint
 from seadesign.sweep.stages import Progress, SolverSettings, mesh_key, tetrahedralize
@@ -39,6 +48,7 @@ class PathResponse:
     vertex_strain: np.ndarray  # (n,) largest tensile principal engineering strain of the elements at each vertex
     snapshot_rotation_rad: float
     snapshot_torque_Nm: float
+    path: TorquePath  # the path's points, stop and events, without its states (what a scaled law reads again)
 
 
 def path_settings(study: Study) -> PathSettings:
@@ -63,21 +73,47 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     hit = cache.get("path", key)
     if hit is not None:
         return hit
+    base, s = candidate.material, 1.0
+    if base.scaled_from is not None and base.law.scale_of(base.scaled_from.law) is not None:
+        base, s = base.scaled_from, base.law.scale_of(base.scaled_from.law)
+    lc, gap = study.load_cases, path_settings(study).contact_gap_mm
+    unscaled = None if s == 1.0 else cache.get("path", path_key(study, replace(candidate, material=base), settings))
+    path = None if unscaled is None else scaled_path(unscaled.path, s, lc.impact_torque_Nm, gap, lc.stall_torque_Nm)
+    if path is not None:  # the uncalibrated path's points are this one's
+        response = replace(unscaled, result=_read(study, candidate, path),
+                           snapshot_torque_Nm=path.points[path.snapshot_index].torque_Nm, path=path)
+    else:
+        response = _solved_response(study, candidate, base.law, s, part, settings, cache, progress)
+    cache.put("path", key, response)
+    return response
+
+
+def _read(study: Study, candidate: Candidate, path: TorquePath) -> LargeDeflection:
+    """The path read at the study's loads."""
+    lc = study.load_cases
+    return large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
+                            candidate.material.strain_limits(study.ranking.safety_factor),
+                            study.ranking.contact_is_end_stop)
+
+
+def _solved_response(study: Study, candidate: Candidate, law: Hyperelastic, s: float, part: Callable[[], Part],
+                     settings: SolverSettings, cache: Cache, progress: Progress) -> PathResponse:
+    """The candidate's path solved on the path mesh under `law` times `s` (`law` driven to the loads over s)."""
     progress("mesh")
     mesh = tetrahedralize(study, candidate, part(), cache, layers=settings.path_layers)
     progress("path")
-    lc, m = study.load_cases, candidate.material
-    path = rotation_path(mesh, m.law, lc.impact_torque_Nm, path_settings(study), order=settings.element_order,
-                         formulation=settings.path_formulation, snapshot_torque_Nm=lc.stall_torque_Nm)
-    result = large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
-                              m.strain_limits(study.ranking.safety_factor), study.ranking.contact_is_end_stop)
-    tensile = Solid.of(path.emesh, m.law, settings.path_formulation).element_strain_stress(
+    lc = study.load_cases
+    path = rotation_path(mesh, law, lc.impact_torque_Nm / s, path_settings(study), order=settings.element_order,
+                         formulation=settings.path_formulation, snapshot_torque_Nm=lc.stall_torque_Nm / s)
+    if s != 1.0:  # serves by construction: driven to the loads over s
+        path = scaled_path(path, s, lc.impact_torque_Nm, path_settings(study).contact_gap_mm, lc.stall_torque_Nm)
+    result = _read(study, candidate, path)
+    tensile = Solid.of(path.emesh, law, settings.path_formulation).element_strain_stress(
         path.snapshot_displacement_m).tensile_strain
     nv = len(mesh.points_mm)
     vertex_strain = np.zeros(nv)
     np.maximum.at(vertex_strain, mesh.tets, tensile[:, None])
     shot = path.points[path.snapshot_index]
-    response = PathResponse(result, mesh.points_mm, mesh.tets, path.snapshot_displacement_m[:nv], vertex_strain,
-                            shot.rotation_rad, shot.torque_Nm)
-    cache.put("path", key, response)
-    return response
+    return PathResponse(result, mesh.points_mm, mesh.tets, path.snapshot_displacement_m[:nv], vertex_strain,
+                        shot.rotation_rad, shot.torque_Nm,
+                        replace(path, displacement_m=None, snapshot_displacement_m=None))
