@@ -123,8 +123,8 @@ def _documented_calibration_lines() -> list[str]:
 @pytest.mark.slow
 def test_the_documented_calibration_example_prints_what_the_docs_show(tmp_path):
     """The docs' worked calibration, run as the page says: `explain-thesis` on the default sweep's spring.json
-    (cached), then `sweep --calibration` with its calibration; the choice lines it prints are the page's. The
-    calibrated sweep recomputes every candidate on the cached meshes (about 10 minutes on 2 cores)."""
+    (cached), then `sweep --calibration` with its calibration; the choice lines it prints are the page's. A
+    stiffness calibration: the calibrated sweep reads every path scaled from the default sweep's (seconds)."""
     out = tmp_path / "exports"
     assert CliRunner().invoke(main, ["sweep", "--quiet", "--out", str(out)]).exit_code == 0
     thesis = CliRunner().invoke(main, ["explain-thesis", "--spring", str(out / "wolfgang_knee" / "spring.json"), "-o",
