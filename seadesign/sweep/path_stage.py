@@ -74,8 +74,9 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     if hit is not None:
         return hit
     base, s = candidate.material, 1.0
-    if base.scaled_from is not None and base.law.scale_of(base.scaled_from.law) is not None:
-        base, s = base.scaled_from, base.law.scale_of(base.scaled_from.law)
+    scale = None if base.scaled_from is None else base.law.scale_of(base.scaled_from.law)
+    if scale is not None:
+        base, s = base.scaled_from, scale
     lc, gap = study.load_cases, path_settings(study).contact_gap_mm
     unscaled = None if s == 1.0 else cache.get("path", path_key(study, replace(candidate, material=base), settings))
     path = None if unscaled is None else scaled_path(unscaled.path, s, lc.impact_torque_Nm, gap, lc.stall_torque_Nm)
