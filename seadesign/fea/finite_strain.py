@@ -19,8 +19,10 @@ import numpy as np
 from seadesign.design.materials import Hyperelastic
 from seadesign.fea.assembly import PairPattern, UpperBlocks
 from seadesign.fea.elements import ElementMesh, barycentric_gradients, quadrature, shape_dlam, upper_pairs
-from seadesign.fea.hyperelastic import det_and_inverse_transpose, i1_tangent, isochoric_energy_density, stress, tangent, volumetric
-from seadesign.fea.kernels import add_element_vectors, contract, deformation_gradients, general_pair_blocks, i1_pair_blocks
+from seadesign.fea.hyperelastic import (det_and_inverse_transpose, i1_tangent, isochoric_energy_density, mooney_rivlin_fields,
+                                       stress, volumetric)
+from seadesign.fea.kernels import (add_element_vectors, contract, deformation_gradients, i1_pair_blocks,
+                                   mooney_rivlin_pair_blocks)
 
 _CHUNK = 4096  # elements per vectorised block
 # A principal direction is tensile (compressive) when its Cauchy stress is above (below) this fraction of the
@@ -101,15 +103,16 @@ class Solid:
 
     def _blocks(self, u_m: np.ndarray, el: slice | np.ndarray, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
         """Tangent blocks K_ab (P, m, 3, 3) in N/m of the selected elements for the pairs (ia, ib): the law's
-        tangent at the quadrature points (laws in I1bar and J as the five terms of `hyperelastic.I1Tangent`,
-        never the 81-component A) contracted with the gradients in `fea.kernels`; with the mean dilatation,
+        tangent at the quadrature points contracted with the gradients in `fea.kernels` (laws in I1bar and J as the
+        five terms of `hyperelastic.I1Tangent`; Mooney-Rivlin's 81-component A built and contracted point by point,
+        never stored); with the mean dilatation,
         plus its rank-one volumetric stiffness U''(Jbar) / V beta_a beta_b, beta = int J F^-T G dV."""
         F, w, gam = self.deformation_gradient(u_m, el), self.weights_m3[el], self._gamma(el)
         md = self._mean_dilatation(F, w)
         pressure = None if md is None else md[0]
         c = np.ascontiguousarray
         if self.law.c01_Pa:
-            blocks = general_pair_blocks(self.dlam, gam, c(w), c(tangent(self.law, F, pressure)[1]), ia, ib)
+            blocks = mooney_rivlin_pair_blocks(self.dlam, gam, c(w), *mooney_rivlin_fields(self.law, F, pressure), ia, ib)
         else:
             t = i1_tangent(self.law, F, pressure)
             terms = (np.broadcast_to(x, w.shape).astype(float) for x in (t.delta, t.cross, t.hh, t.hx, t.w11))

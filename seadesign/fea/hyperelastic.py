@@ -14,14 +14,13 @@ from functools import cached_property
 import numpy as np
 
 from seadesign.design.materials import Hyperelastic
-from seadesign.fea.kernels import det_inverse_transpose, mooney_rivlin_tangent
+from seadesign.fea.kernels import det_inverse_transpose, mooney_rivlin_stress, mooney_rivlin_tangent
 
 _I = np.eye(3)
 
 
 class _Kinematics:
-    """Invariants of F (..., 3, 3) and their first derivatives with respect to F; those of I2 are
-    computed when a law asks for them (Mooney-Rivlin)."""
+    """Invariants of F (..., 3, 3); I2 is computed when a law asks for it (Mooney-Rivlin's energy)."""
 
     def __init__(self, F: np.ndarray) -> None:
         self.F = F
@@ -35,11 +34,6 @@ class _Kinematics:
     @cached_property
     def I2(self) -> np.ndarray:
         return 0.5 * (self.I1**2 - np.sum(self.C * self.C, axis=(-2, -1)))
-
-    @cached_property
-    def dI2(self) -> np.ndarray:
-        """dI2/dF = 2 (I1 F - F C)."""
-        return 2.0 * (self.I1[..., None, None] * self.F - self.F @ self.C)
 
 
 def det_and_inverse_transpose(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -88,21 +82,24 @@ def _first(kin: _Kinematics) -> tuple[np.ndarray, np.ndarray]:
     return j23 * kin.I1, j23[..., None, None] * (2.0 * kin.F - (2 / 3) * kin.I1[..., None, None] * kin.H)
 
 
-def _second(kin: _Kinematics) -> tuple[np.ndarray, np.ndarray]:
-    """I2bar and dI2bar/dF."""
-    j43 = kin.J ** (-4 / 3)
-    return j43 * kin.I2, j43[..., None, None] * (kin.dI2 - (4 / 3) * kin.I2[..., None, None] * kin.H)
+def _mooney_rivlin_stress(law: Hyperelastic, kin: _Kinematics, wj: np.ndarray) -> np.ndarray:
+    """P (Pa) of a law with I2bar, U'(J) = wj, in one compiled pass per point (`fea.kernels.mooney_rivlin_stress`)."""
+    w1 = _isochoric(law, kin.J ** (-2 / 3) * kin.I1)[0]
+    fields = (kin.F, kin.H, kin.J, kin.I1, w1, law.c01_Pa, wj * kin.J)
+    flat = (_field(x, kin.J.shape).reshape((kin.J.size,) + np.shape(x)[kin.J.ndim:]) for x in fields)
+    return mooney_rivlin_stress(*flat).reshape(kin.F.shape)
 
 
 def stress(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> np.ndarray:
     """First Piola-Kirchhoff stress P = dW/dF (Pa), shape of F. `pressure_Pa` replaces U'(J) (a mean
     dilatation formulation passes U' of the element's mean J)."""
     kin = _Kinematics(F)
-    i1b, d1 = _first(kin)
     wj = _volumetric_slopes(law, kin.J, pressure_Pa)[0]
+    if law.c01_Pa:
+        return _mooney_rivlin_stress(law, kin, wj)
+    i1b, d1 = _first(kin)
     e = (..., None, None)
-    p = _isochoric(law, i1b)[0][e] * d1 + (wj * kin.J)[e] * kin.H
-    return p + law.c01_Pa * _second(kin)[1] if law.c01_Pa else p
+    return _isochoric(law, i1b)[0][e] * d1 + (wj * kin.J)[e] * kin.H
 
 
 def _outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -159,11 +156,22 @@ def i1_tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None 
                      (2 / 3) * s * I1 - wj * J, w11)
 
 
-def _points(x, shape: tuple[int, ...]) -> np.ndarray:
-    """A field over the points `shape` (scalar or with trailing (3, 3)) as a contiguous float array, points flattened."""
+def _field(x, shape: tuple[int, ...]) -> np.ndarray:
+    """A field over the points `shape` (scalar, or with trailing (3, 3)) as a contiguous float array."""
     x = np.asarray(x, dtype=float)
     tail = x.shape[len(shape):] if x.ndim > len(shape) else ()
-    return np.ascontiguousarray(np.broadcast_to(x, shape + tail)).reshape((-1,) + tail)
+    return np.ascontiguousarray(np.broadcast_to(x, shape + tail))
+
+
+def mooney_rivlin_fields(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+    """The fields that give A = dP/dF of a law linear in I2bar at each F (..., 3, 3) (`fea.kernels.mooney_rivlin_tangent`),
+    each over the points of F: F, H = F^-T, J, I1, w1 = dW/dI1bar, w11, w2 = dW/dI2bar, vhh, vhx (Pa); `pressure_Pa`
+    as in `tangent`."""
+    kin = _Kinematics(F)
+    w1, w11 = _isochoric(law, kin.J ** (-2 / 3) * kin.I1)
+    wj, wjj = _volumetric_slopes(law, kin.J, pressure_Pa)
+    fields = (kin.F, kin.H, kin.J, kin.I1, w1, w11, law.c01_Pa, wjj * kin.J**2 + wj * kin.J, wj * kin.J)
+    return tuple(_field(x, kin.J.shape) for x in fields)
 
 
 def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -174,12 +182,6 @@ def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = N
     if not law.c01_Pa:
         t = i1_tangent(law, F, pressure_Pa)
         return t.P, t.full()
-    kin = _Kinematics(F)
-    (i1b, d1), (_, d2) = _first(kin), _second(kin)
-    (w1, w11), w2 = _isochoric(law, i1b), law.c01_Pa
-    wj, wjj = _volumetric_slopes(law, kin.J, pressure_Pa)
-    e = (..., None, None)
-    P = w1[e] * d1 + (wj * kin.J)[e] * kin.H + w2 * d2  # the order of `stress`: the same P to the last bit
-    fields = (kin.F, kin.H, kin.J, kin.I1, kin.I2, w1, w11, w2, wjj * kin.J**2 + wj * kin.J, wj * kin.J)
-    a = mooney_rivlin_tangent(*(_points(x, kin.J.shape) for x in fields))
-    return P, a.reshape(F.shape[:-2] + (3, 3, 3, 3))
+    points = F.shape[:-2]
+    a = mooney_rivlin_tangent(*(x.reshape((-1,) + x.shape[len(points):]) for x in mooney_rivlin_fields(law, F, pressure_Pa)))
+    return stress(law, F, pressure_Pa), a.reshape(points + (3, 3, 3, 3))

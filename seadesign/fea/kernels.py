@@ -72,24 +72,29 @@ def i1_pair_blocks(dlam: np.ndarray, gamma: np.ndarray, weights: np.ndarray, F: 
 
 
 @njit(cache=True, nogil=True)
-def general_pair_blocks(dlam: np.ndarray, gamma: np.ndarray, weights: np.ndarray, A: np.ndarray, ia: np.ndarray,
-                        ib: np.ndarray) -> np.ndarray:
-    """Pair blocks (P, m, 3, 3) from the full tangent A (m, q, 3, 3, 3, 3) in Pa, A[iJkL] = dP_iJ / dF_kL:
-    K_ab[i, k] = sum_q w sum_JL G_aJ A_iJkL G_bL (any law, e.g. Mooney-Rivlin)."""
+def mooney_rivlin_pair_blocks(dlam: np.ndarray, gamma: np.ndarray, weights: np.ndarray, F: np.ndarray, H: np.ndarray,
+                              J: np.ndarray, I1: np.ndarray, w1: np.ndarray, w11: np.ndarray, w2: np.ndarray,
+                              vhh: np.ndarray, vhx: np.ndarray, ia: np.ndarray, ib: np.ndarray) -> np.ndarray:
+    """Pair blocks (P, m, 3, 3) of a law linear in I2bar: K_ab[i, k] = sum_q w sum_JL G_aJ A_iJkL G_bL with A at each
+    point as in `mooney_rivlin_tangent` (its fields (m, q), F and H (m, q, 3, 3)), built and contracted in one pass."""
     m, nq, nen, npairs = gamma.shape[0], dlam.shape[0], dlam.shape[1], len(ia)
     out = np.zeros((npairs, m, 3, 3))
     g = np.empty((nen, 3))
+    a4 = np.empty((3, 3, 3, 3))
     t = np.empty((nen, 3, 3, 3))  # T_a[i, k, L] = w sum_J G_aJ A_iJkL
+    work = np.empty((6, 3, 3))
     for e in range(m):
         for q in range(nq):
             w = weights[e, q]
             _gradients(dlam, gamma, q, e, g)
+            _mooney_rivlin_point(F[e, q], H[e, q], J[e, q], I1[e, q], w1[e, q], w11[e, q], w2[e, q], vhh[e, q],
+                                 vhx[e, q], work, a4)
             for a in range(nen):
                 for i in range(3):
                     for k in range(3):
                         for L in range(3):
-                            t[a, i, k, L] = w * (g[a, 0] * A[e, q, i, 0, k, L] + g[a, 1] * A[e, q, i, 1, k, L]
-                                                 + g[a, 2] * A[e, q, i, 2, k, L])
+                            t[a, i, k, L] = w * (g[a, 0] * a4[i, 0, k, L] + g[a, 1] * a4[i, 1, k, L]
+                                                 + g[a, 2] * a4[i, 2, k, L])
             for p in range(npairs):
                 a, b = ia[p], ib[p]
                 for i in range(3):
@@ -99,48 +104,90 @@ def general_pair_blocks(dlam: np.ndarray, gamma: np.ndarray, weights: np.ndarray
 
 
 @njit(cache=True, nogil=True)
-def mooney_rivlin_tangent(F: np.ndarray, H: np.ndarray, J: np.ndarray, I1: np.ndarray, I2: np.ndarray, w1: np.ndarray,
+def _second_invariant(i1: float, c: np.ndarray) -> float:
+    """I2 = (I1^2 - C:C) / 2 of the right Cauchy-Green tensor c (3, 3)."""
+    cc = 0.0
+    for r in range(3):
+        for s in range(3):
+            cc += c[r, s] * c[r, s]
+    return 0.5 * (i1 * i1 - cc)
+
+
+@njit(cache=True, nogil=True)
+def mooney_rivlin_stress(F: np.ndarray, H: np.ndarray, J: np.ndarray, I1: np.ndarray, w1: np.ndarray, w2: np.ndarray,
+                         vh: np.ndarray) -> np.ndarray:
+    """P = dW/dF (n, 3, 3) in Pa of W(I1bar, I2bar, J) linear in I2bar at each F (n, 3, 3) (H = F^-T, J, I1 = tr C):
+    w1 dI1bar/dF + w2 dI2bar/dF + vh H, with w1 = dW/dI1bar, w2 = dW/dI2bar and vh = U' J (Pa);
+    dI1bar/dF = J^-2/3 (2 F - 2/3 I1 H), dI2bar/dF = J^-4/3 (2 (I1 F - F C) - 4/3 I2 H)."""
+    n = F.shape[0]
+    out = np.empty((n, 3, 3))
+    c = np.empty((3, 3))
+    for e in range(n):
+        f, h = F[e], H[e]
+        j23, j43 = J[e] ** (-2.0 / 3.0), J[e] ** (-4.0 / 3.0)
+        i1 = I1[e]
+        for r in range(3):
+            for s in range(3):
+                c[r, s] = f[0, r] * f[0, s] + f[1, r] * f[1, s] + f[2, r] * f[2, s]
+        i2 = _second_invariant(i1, c)
+        for r in range(3):
+            for s in range(3):
+                fc = f[r, 0] * c[0, s] + f[r, 1] * c[1, s] + f[r, 2] * c[2, s]
+                d1 = j23 * (2.0 * f[r, s] - (2.0 / 3.0) * i1 * h[r, s])
+                d2 = j43 * (2.0 * (i1 * f[r, s] - fc) - (4.0 / 3.0) * i2 * h[r, s])
+                out[e, r, s] = w1[e] * d1 + w2[e] * d2 + vh[e] * h[r, s]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def mooney_rivlin_tangent(F: np.ndarray, H: np.ndarray, J: np.ndarray, I1: np.ndarray, w1: np.ndarray,
                           w11: np.ndarray, w2: np.ndarray, vhh: np.ndarray, vhx: np.ndarray) -> np.ndarray:
     """A = dP/dF (n, 3, 3, 3, 3), A[iJkL] = dP_iJ / dF_kL (Pa), of W(I1bar, I2bar, J) linear in I2bar at each F (n, 3, 3)
-    (H = F^-T, J, I1 = tr C, I2 = I2(C)): w11 dI1b x dI1b + w1 d2I1b + w2 d2I2b + vhh H_iJ H_kL - vhx H_iL H_kJ, with
+    (H = F^-T, J, I1 = tr C; I2 = I2(C)): w11 dI1b x dI1b + w1 d2I1b + w2 d2I2b + vhh H_iJ H_kL - vhx H_iL H_kJ, with
     w1 = dW/dI1bar, w11 = d2W/dI1bar2, w2 = dW/dI2bar (Pa) and the volumetric vhh = U'' J^2 + U' J, vhx = U' J (Pa);
     d2I1b = J^-2/3 (-2/3 (2 F - 2/3 I1 H) x H + 2 d_ik d_JL - 4/3 H x F + 2/3 I1 H_iL H_kJ),
     d2I2b = J^-4/3 (-4/3 (dI2 - 4/3 I2 H) x H + d2I2 - 4/3 H x dI2 + 4/3 I2 H_iL H_kJ),
     d2I2 = 2 (2 F_iJ F_kL + I1 d_ik d_JL - d_ik C_LJ - F_iL F_kJ - b_ik d_JL), dI2 = 2 (I1 F - F C), b = F F^T."""
     n = F.shape[0]
     out = np.empty((n, 3, 3, 3, 3))
-    c, b, di2 = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
-    x, y, d1 = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
+    work = np.empty((6, 3, 3))
     for e in range(n):
-        f, h = F[e], H[e]
-        j23, j43 = J[e] ** (-2.0 / 3.0), J[e] ** (-4.0 / 3.0)
-        i1, i2 = I1[e], I2[e]
-        for r in range(3):
-            for s in range(3):
-                c[r, s] = f[0, r] * f[0, s] + f[1, r] * f[1, s] + f[2, r] * f[2, s]
-                b[r, s] = f[r, 0] * f[s, 0] + f[r, 1] * f[s, 1] + f[r, 2] * f[s, 2]
-        for r in range(3):
-            for s in range(3):
-                fc = f[r, 0] * c[0, s] + f[r, 1] * c[1, s] + f[r, 2] * c[2, s]
-                di2[r, s] = 2.0 * (i1 * f[r, s] - fc)
-                x[r, s] = 2.0 * f[r, s] - (2.0 / 3.0) * i1 * h[r, s]
-                y[r, s] = di2[r, s] - (4.0 / 3.0) * i2 * h[r, s]
-                d1[r, s] = j23 * x[r, s]
-        for i in range(3):
-            for jj in range(3):
-                for k in range(3):
-                    for L in range(3):
-                        dik, djl = 1.0 if i == k else 0.0, 1.0 if jj == L else 0.0
-                        hx = h[i, L] * h[k, jj]
-                        dd1 = j23 * (-(2.0 / 3.0) * x[i, jj] * h[k, L] + 2.0 * dik * djl - (4.0 / 3.0) * h[i, jj] * f[k, L]
-                                     + (2.0 / 3.0) * i1 * hx)
-                        ddi2 = 2.0 * (2.0 * f[i, jj] * f[k, L] + i1 * dik * djl - dik * c[L, jj] - f[i, L] * f[k, jj]
-                                      - b[i, k] * djl)
-                        dd2 = j43 * (-(4.0 / 3.0) * y[i, jj] * h[k, L] + ddi2 - (4.0 / 3.0) * h[i, jj] * di2[k, L]
-                                     + (4.0 / 3.0) * i2 * hx)
-                        out[e, i, jj, k, L] = (w11[e] * d1[i, jj] * d1[k, L] + w1[e] * dd1 + w2[e] * dd2
-                                               + vhh[e] * h[i, jj] * h[k, L] - vhx[e] * hx)
+        _mooney_rivlin_point(F[e], H[e], J[e], I1[e], w1[e], w11[e], w2[e], vhh[e], vhx[e], work, out[e])
     return out
+
+
+@njit(cache=True, nogil=True)
+def _mooney_rivlin_point(f: np.ndarray, h: np.ndarray, j: float, i1: float, w1: float, w11: float, w2: float,
+                         vhh: float, vhx: float, work: np.ndarray, out: np.ndarray) -> None:
+    """A (3, 3, 3, 3) of `mooney_rivlin_tangent` at one point into out; work (6, 3, 3) is scratch."""
+    c, b, di2, x, y, d1 = work[0], work[1], work[2], work[3], work[4], work[5]
+    j23, j43 = j ** (-2.0 / 3.0), j ** (-4.0 / 3.0)
+    for r in range(3):
+        for s in range(3):
+            c[r, s] = f[0, r] * f[0, s] + f[1, r] * f[1, s] + f[2, r] * f[2, s]
+            b[r, s] = f[r, 0] * f[s, 0] + f[r, 1] * f[s, 1] + f[r, 2] * f[s, 2]
+    i2 = _second_invariant(i1, c)
+    for r in range(3):
+        for s in range(3):
+            fc = f[r, 0] * c[0, s] + f[r, 1] * c[1, s] + f[r, 2] * c[2, s]
+            di2[r, s] = 2.0 * (i1 * f[r, s] - fc)
+            x[r, s] = 2.0 * f[r, s] - (2.0 / 3.0) * i1 * h[r, s]
+            y[r, s] = di2[r, s] - (4.0 / 3.0) * i2 * h[r, s]
+            d1[r, s] = j23 * x[r, s]
+    for i in range(3):
+        for jj in range(3):
+            for k in range(3):
+                for L in range(3):
+                    dik, djl = 1.0 if i == k else 0.0, 1.0 if jj == L else 0.0
+                    hx = h[i, L] * h[k, jj]
+                    dd1 = j23 * (-(2.0 / 3.0) * x[i, jj] * h[k, L] + 2.0 * dik * djl - (4.0 / 3.0) * h[i, jj] * f[k, L]
+                                 + (2.0 / 3.0) * i1 * hx)
+                    ddi2 = 2.0 * (2.0 * f[i, jj] * f[k, L] + i1 * dik * djl - dik * c[L, jj] - f[i, L] * f[k, jj]
+                                  - b[i, k] * djl)
+                    dd2 = j43 * (-(4.0 / 3.0) * y[i, jj] * h[k, L] + ddi2 - (4.0 / 3.0) * h[i, jj] * di2[k, L]
+                                 + (4.0 / 3.0) * i2 * hx)
+                    out[i, jj, k, L] = (w11 * d1[i, jj] * d1[k, L] + w1 * dd1 + w2 * dd2 + vhh * h[i, jj] * h[k, L]
+                                        - vhx * hx)
 
 
 @njit(cache=True, nogil=True)
