@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -82,21 +83,13 @@ def _first(kin: _Kinematics) -> tuple[np.ndarray, np.ndarray]:
     return j23 * kin.I1, j23[..., None, None] * (2.0 * kin.F - (2 / 3) * kin.I1[..., None, None] * kin.H)
 
 
-def _mooney_rivlin_stress(law: Hyperelastic, kin: _Kinematics, wj: np.ndarray) -> np.ndarray:
-    """P (Pa) of a law with I2bar, U'(J) = wj, in one compiled pass per point (`fea.kernels.mooney_rivlin_stress`)."""
-    w1 = _isochoric(law, kin.J ** (-2 / 3) * kin.I1)[0]
-    fields = (kin.F, kin.H, kin.J, kin.I1, w1, law.c01_Pa, wj * kin.J)
-    flat = (_field(x, kin.J.shape).reshape((kin.J.size,) + np.shape(x)[kin.J.ndim:]) for x in fields)
-    return mooney_rivlin_stress(*flat).reshape(kin.F.shape)
-
-
 def stress(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> np.ndarray:
     """First Piola-Kirchhoff stress P = dW/dF (Pa), shape of F. `pressure_Pa` replaces U'(J) (a mean
     dilatation formulation passes U' of the element's mean J)."""
+    if law.c01_Pa:
+        return _mooney_rivlin_stress(mooney_rivlin_fields(law, F, pressure_Pa).flat()).reshape(F.shape)
     kin = _Kinematics(F)
     wj = _volumetric_slopes(law, kin.J, pressure_Pa)[0]
-    if law.c01_Pa:
-        return _mooney_rivlin_stress(law, kin, wj)
     i1b, d1 = _first(kin)
     e = (..., None, None)
     return _isochoric(law, i1b)[0][e] * d1 + (wj * kin.J)[e] * kin.H
@@ -163,15 +156,39 @@ def _field(x, shape: tuple[int, ...]) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(x, shape + tail))
 
 
-def mooney_rivlin_fields(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
-    """The fields that give A = dP/dF of a law linear in I2bar at each F (..., 3, 3) (`fea.kernels.mooney_rivlin_tangent`),
-    each over the points of F: F, H = F^-T, J, I1, w1 = dW/dI1bar, w11, w2 = dW/dI2bar, vhh, vhx (Pa); `pressure_Pa`
-    as in `tangent`."""
+class MooneyRivlinFields(NamedTuple):
+    """What gives P and A = dP/dF of a law linear in I2bar (`fea.kernels.mooney_rivlin_tangent`) at each point: F and
+    H = F^-T (..., 3, 3), J, I1 = tr C, w1 = dW/dI1bar, w11 = d2W/dI1bar2, w2 = dW/dI2bar and the volumetric
+    vhh = U'' J^2 + U' J, vhx = U' J (..., in Pa)."""
+
+    F: np.ndarray
+    H: np.ndarray
+    J: np.ndarray
+    I1: np.ndarray
+    w1: np.ndarray
+    w11: np.ndarray
+    w2: np.ndarray
+    vhh: np.ndarray
+    vhx: np.ndarray
+
+    def flat(self) -> "MooneyRivlinFields":
+        """The same fields with the points in one axis, as the kernels take them."""
+        points = self.J.ndim
+        return MooneyRivlinFields(*(x.reshape((-1,) + x.shape[points:]) for x in self))
+
+
+def mooney_rivlin_fields(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> MooneyRivlinFields:
+    """`MooneyRivlinFields` at each F (..., 3, 3), contiguous; `pressure_Pa` as in `tangent`."""
     kin = _Kinematics(F)
     w1, w11 = _isochoric(law, kin.J ** (-2 / 3) * kin.I1)
     wj, wjj = _volumetric_slopes(law, kin.J, pressure_Pa)
     fields = (kin.F, kin.H, kin.J, kin.I1, w1, w11, law.c01_Pa, wjj * kin.J**2 + wj * kin.J, wj * kin.J)
-    return tuple(_field(x, kin.J.shape) for x in fields)
+    return MooneyRivlinFields(*(_field(x, kin.J.shape) for x in fields))
+
+
+def _mooney_rivlin_stress(f: MooneyRivlinFields) -> np.ndarray:
+    """P (n, 3, 3) in Pa from flat fields, one compiled pass per point (`fea.kernels.mooney_rivlin_stress`)."""
+    return mooney_rivlin_stress(f.F, f.H, f.J, f.I1, f.w1, f.w2, f.vhx)
 
 
 def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -182,6 +199,5 @@ def tangent(law: Hyperelastic, F: np.ndarray, pressure_Pa: np.ndarray | None = N
     if not law.c01_Pa:
         t = i1_tangent(law, F, pressure_Pa)
         return t.P, t.full()
-    points = F.shape[:-2]
-    a = mooney_rivlin_tangent(*(x.reshape((-1,) + x.shape[len(points):]) for x in mooney_rivlin_fields(law, F, pressure_Pa)))
-    return stress(law, F, pressure_Pa), a.reshape(points + (3, 3, 3, 3))
+    f = mooney_rivlin_fields(law, F, pressure_Pa).flat()
+    return _mooney_rivlin_stress(f).reshape(F.shape), mooney_rivlin_tangent(*f).reshape(F.shape + (3, 3))
