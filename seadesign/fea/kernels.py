@@ -104,11 +104,12 @@ def mooney_rivlin_pair_blocks(dlam: np.ndarray, gamma: np.ndarray, weights: np.n
 
 
 @njit(cache=True, nogil=True)
-def _second_invariant(i1: float, c: np.ndarray) -> float:
-    """I2 = (I1^2 - C:C) / 2 of the right Cauchy-Green tensor c (3, 3)."""
+def _cauchy_green(f: np.ndarray, i1: float, c: np.ndarray) -> float:
+    """C = F^T F of f (3, 3) into c (3, 3); returns I2 = (I1^2 - C:C) / 2 (i1 = tr C)."""
     cc = 0.0
     for r in range(3):
         for s in range(3):
+            c[r, s] = f[0, r] * f[0, s] + f[1, r] * f[1, s] + f[2, r] * f[2, s]
             cc += c[r, s] * c[r, s]
     return 0.5 * (i1 * i1 - cc)
 
@@ -126,10 +127,7 @@ def mooney_rivlin_stress(F: np.ndarray, H: np.ndarray, J: np.ndarray, I1: np.nda
         f, h = F[e], H[e]
         j23, j43 = J[e] ** (-2.0 / 3.0), J[e] ** (-4.0 / 3.0)
         i1 = I1[e]
-        for r in range(3):
-            for s in range(3):
-                c[r, s] = f[0, r] * f[0, s] + f[1, r] * f[1, s] + f[2, r] * f[2, s]
-        i2 = _second_invariant(i1, c)
+        i2 = _cauchy_green(f, i1, c)
         for r in range(3):
             for s in range(3):
                 fc = f[r, 0] * c[0, s] + f[r, 1] * c[1, s] + f[r, 2] * c[2, s]
@@ -162,11 +160,10 @@ def _mooney_rivlin_point(f: np.ndarray, h: np.ndarray, j: float, i1: float, w1: 
     """A (3, 3, 3, 3) of `mooney_rivlin_tangent` at one point into out; work (6, 3, 3) is scratch."""
     c, b, di2, x, y, d1 = work[0], work[1], work[2], work[3], work[4], work[5]
     j23, j43 = j ** (-2.0 / 3.0), j ** (-4.0 / 3.0)
+    i2 = _cauchy_green(f, i1, c)
     for r in range(3):
         for s in range(3):
-            c[r, s] = f[0, r] * f[0, s] + f[1, r] * f[1, s] + f[2, r] * f[2, s]
             b[r, s] = f[r, 0] * f[s, 0] + f[r, 1] * f[s, 1] + f[r, 2] * f[s, 2]
-    i2 = _second_invariant(i1, c)
     for r in range(3):
         for s in range(3):
             fc = f[r, 0] * c[0, s] + f[r, 1] * c[1, s] + f[r, 2] * c[2, s]
