@@ -2,8 +2,10 @@
 
 Cold: empty cache and no stored rows. Warm: the same command again (rows reused). Each run is
 the `seadesign sweep` command in a child process, so its import time is counted, and its peak resident memory
-is sampled every 0.2 s (a shorter peak can be missed) twice: the largest single process (the command or one of its
-workers) and the machine's share, the sum over the command and all its descendants.
+is sampled every 0.2 s (a shorter peak can be missed) three ways: the largest single process (the command or one of
+its workers, resident set), the resident sets summed over the command and all its descendants (which counts the
+pages of shared libraries once per process), and their proportional set sizes summed (each shared page split among
+the processes that map it: the memory the run takes from the machine).
 
 Usage: python benchmarks/sweep.py [STUDY] [--jobs N]
 """
@@ -23,36 +25,39 @@ import psutil
 from record import machine
 
 
-def timed_sweep(study: str, jobs: int, out: Path, cache: Path) -> tuple[float, float, float]:
-    """(wall s, peak RSS MiB of one process, peak of the RSS MiB summed over the command and its descendants) of one
-    `seadesign sweep` run."""
+def timed_sweep(study: str, jobs: int, out: Path, cache: Path) -> tuple[float, float, float, float]:
+    """(wall s, peak RSS MiB of one process, peak of the RSS MiB and of the PSS MiB summed over the command and its
+    descendants) of one `seadesign sweep` run."""
     t0 = time.perf_counter()
     run = subprocess.Popen([str(Path(sys.executable).parent / "seadesign"), "sweep", study, "--jobs", str(jobs),
                             "--quiet", "--out", str(out), "--cache-dir", str(cache)], stdout=subprocess.DEVNULL)
-    command, one, total = psutil.Process(run.pid), 0.0, 0.0
+    command, one, total, share = psutil.Process(run.pid), 0.0, 0.0, 0.0
     while run.poll() is None:
-        rss = _tree_rss(command)
-        one, total = max([one, *rss]), max(total, sum(rss))
+        rss, pss = _tree_memory(command)
+        one, total, share = max([one, *rss]), max(total, sum(rss)), max(share, sum(pss))
         time.sleep(0.2)
     wall = time.perf_counter() - t0
     if run.returncode:
         raise SystemExit(f"seadesign sweep failed with exit code {run.returncode}")
-    return wall, one / 2**20, total / 2**20
+    return wall, one / 2**20, total / 2**20, share / 2**20
 
 
-def _tree_rss(command: psutil.Process) -> list[float]:
-    """Resident bytes of the command and each of its descendants now (those that end while read are left out)."""
-    out = []
+def _tree_memory(command: psutil.Process) -> tuple[list[float], list[float]]:
+    """Resident and proportional set sizes (bytes) of the command and each of its descendants now (those that end
+    while read are left out)."""
+    rss, pss = [], []
     try:
         processes = [command] + command.children(recursive=True)
     except psutil.NoSuchProcess:
-        return out
+        return rss, pss
     for p in processes:
         try:
-            out.append(float(p.memory_info().rss))
-        except psutil.NoSuchProcess:
-            pass
-    return out
+            m = p.memory_full_info()
+        except (psutil.NoSuchProcess, psutil.AccessDenied):
+            continue
+        rss.append(float(m.rss))
+        pss.append(float(m.pss))
+    return rss, pss
 
 
 def main() -> None:
@@ -66,9 +71,10 @@ def main() -> None:
         warm = timed_sweep(args.study, args.jobs, out, cache)
     print(f"machine: {machine()}")
     print(f"settings: study {args.study}, jobs {args.jobs}")
-    print(f"{'run':<6} {'wall_s':>8} {'peak_rss_one_process_MiB':>25} {'peak_rss_all_processes_MiB':>27}")
-    for name, (wall, rss, total) in (("cold", cold), ("warm", warm)):
-        print(f"{name:<6} {wall:>8.1f} {rss:>25.0f} {total:>27.0f}")
+    print(f"{'run':<6} {'wall_s':>8} {'peak_rss_one_process_MiB':>25} {'peak_rss_all_processes_MiB':>27} "
+          f"{'peak_pss_all_processes_MiB':>27}")
+    for name, (wall, rss, total, share) in (("cold", cold), ("warm", warm)):
+        print(f"{name:<6} {wall:>8.1f} {rss:>25.0f} {total:>27.0f} {share:>27.0f}")
 
 
 if __name__ == "__main__":
