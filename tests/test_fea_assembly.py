@@ -82,11 +82,11 @@ def test_condensation_and_solve_match_explicit_transform(small):
     rhs[cpl.ref_dofs[5]] = 1.0
     expected = np.linalg.solve(explicit, rhs)
     upper = cpl.condense(stiffness_upper(emesh, E, NU, cpl.node_index, cpl.n_rows)).matrix()
-    for backend in ("pardiso", "scipy"):
-        fact = SPDFactorization(upper, backend=backend)
+    for backend, precision in (("pardiso", "double"), ("pardiso", "mixed"), ("scipy", "double")):
+        fact = SPDFactorization(upper, backend=backend, precision=precision)
         q = fact.solve(rhs)
         fact.close()
-        assert np.abs(q - expected).max() < 1e-8 * np.abs(expected).max()
+        assert np.abs(q - expected).max() < 1e-8 * np.abs(expected).max()  # single-precision factors alone: 1e-6
 
     u = cpl.displacements(expected)
     assert np.allclose(u.ravel(), t @ expected)
@@ -95,6 +95,34 @@ def test_condensation_and_solve_match_explicit_transform(small):
     assert np.allclose(f[hub], full[hub], atol=1e-9) and np.allclose(f[ring], full[ring], atol=1e-9)
     torque = lambda nodes: np.sum(emesh.nodes_m[nodes, 0] * f[nodes, 1] - emesh.nodes_m[nodes, 1] * f[nodes, 0])  # noqa: E731
     assert torque(hub) == pytest.approx(1.0, rel=1e-9) and torque(ring) == pytest.approx(-1.0, rel=1e-9)
+
+
+def _conditioned(condition: float, n: int = 60) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray]:
+    """An SPD matrix (upper CSR) with eigenvalues from 1 to `condition`, a load and LAPACK's solution."""
+    rng = np.random.default_rng(0)
+    q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    a = q @ np.diag(np.logspace(0, np.log10(condition), n)) @ q.T
+    b = rng.standard_normal(n)
+    return sp.csr_matrix(np.triu(a)), b, np.linalg.solve(a, b)
+
+
+@pytest.mark.parametrize("condition, maxiter", [(1e9, None), (1e7, 1)])
+def test_mixed_precision_falls_back_to_double_where_single_precision_fails(monkeypatch, condition, maxiter):
+    """Cond 1e9: the single-precision Cholesky meets a negative pivot; cond 1e7 with one iteration allowed: the
+    refinement does not converge. Either way the answer is the double-precision one, never an error or a guess."""
+    import seadesign.fea.linsolve as linsolve
+
+    if maxiter is not None:
+        monkeypatch.setattr(linsolve, "MIXED_MAXITER", maxiter)
+    upper, b, x = _conditioned(condition)
+    y = SPDFactorization(upper, precision="mixed").solve(b)
+    assert np.abs(y - x).max() < 1e-7 * np.abs(x).max()  # LAPACK's own error here: 3e-9 (cond 1e9)
+
+
+def test_mixed_precision_needs_pardiso():
+    upper, _, _ = _conditioned(10.0)
+    with pytest.raises(SolverError, match="'mixed' with 'pardiso'"):
+        SPDFactorization(upper, backend="scipy", precision="mixed")
 
 
 def test_mass_matrix_integrates_volume(small):

@@ -69,14 +69,17 @@ class Pardiso:
     """Cholesky factorization of an SPD matrix given as its upper triangle: scalar CSR, or BSR
     whose block entries hold col >= row with full diagonal blocks."""
 
-    def __init__(self, upper: sp.csr_matrix | sp.bsr_matrix, indefinite: bool = False) -> None:
-        """indefinite=True: an LDL^T factorization of any symmetric matrix, for its `inertia`."""
+    def __init__(self, upper: sp.csr_matrix | sp.bsr_matrix, indefinite: bool = False, single: bool = False) -> None:
+        """indefinite=True: an LDL^T factorization of any symmetric matrix, for its `inertia`. single=True: the
+        factors in single precision (half the memory; solutions to about 1e-7 relative, a preconditioner for an
+        iterative solve in double precision, `linsolve.SPDFactorization(precision="mixed")`)."""
         self._lib = _library()
         self._mtype = _SYMMETRIC if indefinite else _SPD
+        self._dtype = np.float32 if single else np.float64  # PARDISO reads the values and vectors in this precision
         self.n = upper.shape[0]
         block = upper.blocksize[0] if sp.issparse(upper) and upper.format == "bsr" else 1
         upper.sort_indices()
-        self._data = np.ascontiguousarray(upper.data, dtype=np.float64)
+        self._data = np.ascontiguousarray(upper.data, dtype=self._dtype)
         self._ia = np.ascontiguousarray(upper.indptr, dtype=np.int32)
         self._ja = np.ascontiguousarray(upper.indices, dtype=np.int32)
         self._rows = self.n // block
@@ -89,12 +92,14 @@ class Pardiso:
         if indefinite:
             self._iparm[20] = 0  # 1x1 diagonal pivots, not Bunch-Kaufman's 2x2: the path's tangents are positive
             # definite or lose it by a few eigenvalues, and the factorization is faster (docs/validation/timing.md)
+        self._iparm[27] = int(single)
         self._iparm[34] = 1  # zero-based indices
         self._iparm[36] = block if block > 1 else 0
         self._alive = True
         self._call(12, np.zeros(self.n))
 
     def _call(self, phase: int, b: np.ndarray) -> np.ndarray:
+        b = np.asfortranarray(b, dtype=self._dtype)  # PARDISO reads columns
         x = np.zeros_like(b)
         err = _I32(0)
         nrhs = 1 if b.ndim == 1 else b.shape[1]
@@ -147,13 +152,12 @@ class Pardiso:
         """Factor new values on the same sparsity pattern, reusing the ordering and symbolic analysis."""
         if not self.same_pattern(upper):
             raise SolverError("refactor needs the sparsity pattern of the first factorization")
-        self._data = np.ascontiguousarray(upper.data, dtype=np.float64)
+        self._data = np.ascontiguousarray(upper.data, dtype=self._dtype)
         self._call(22, np.zeros(self.n))
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """Solution for one (n,) or several (n, r) right-hand sides."""
-        b = np.asfortranarray(b, dtype=np.float64)  # PARDISO reads columns
-        return np.ascontiguousarray(self._call(33, b))
+        return np.ascontiguousarray(self._call(33, b), dtype=np.float64)
 
     def close(self) -> None:
         """Release the factorization (MKL holds it outside Python's heap)."""
