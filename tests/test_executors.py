@@ -48,3 +48,30 @@ def test_workers_are_kept_between_calls_only_while_asked():
         kept = set(executors._kept[2][1]._processes)  # the kept pool's worker processes
         assert used <= kept and len(kept) == 2
     assert not any(psutil.pid_exists(p) and psutil.Process(p).status() != psutil.STATUS_ZOMBIE for p in kept)
+
+
+def _heavy(task, sink) -> tuple[float, float, bool]:
+    """(start, end) of a heavy stage held 0.4 s (monotonic clock, shared by the processes), and whether another
+    worker was in one when this one arrived."""
+    import time
+
+    from seadesign.run.heavy_stage import heavy_stage, heavy_stage_busy
+
+    time.sleep(0.1 * task)  # the second task arrives while the first holds the stage
+    busy = heavy_stage_busy()
+    with heavy_stage():
+        start = time.monotonic()
+        time.sleep(0.4)
+        return start, time.monotonic(), busy
+
+
+def test_local_workers_take_heavy_stages_one_at_a_time():
+    results = sorted(r for _, r in execute(_heavy, [0, 1], "local", 2, None, lambda *a: None, lambda: None, []))
+    (s0, e0, busy0), (s1, e1, busy1) = results
+    assert s1 >= e0  # the second waited for the first
+    assert (busy0, busy1) == (False, True)
+
+
+def test_heavy_stages_run_freely_outside_a_local_pool():
+    results = [r for _, r in execute(_heavy, [0], "serial", 1, None, lambda *a: None, lambda: None, [])]
+    assert results[0][2] is False

@@ -22,6 +22,7 @@ from typing import Any, Callable, Iterator
 import psutil
 
 from seadesign.errors import SeadesignError
+from seadesign.run.heavy_stage import install as install_heavy_lock
 from seadesign.run.interrupt import ignore_sigint, kill_trees
 
 POLL_S = 0.25  # how often stage messages are drained while waiting for results
@@ -77,8 +78,8 @@ def _pool(jobs: int) -> tuple:
         return _kept[jobs]
     ctx = mp.get_context("spawn")
     threads = max(1, default_jobs() // jobs)  # solver threads per worker: no oversubscription
-    made = (ctx.Manager(),
-            ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_worker, initargs=(threads,)))
+    made = (ctx.Manager(), ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_init_worker,
+                                               initargs=(threads, ctx.Lock())))
     if _kept is not None:
         _kept[jobs] = made
     return made
@@ -118,13 +119,15 @@ def run_processes(fn, tasks: list, jobs: int, on_stage: Callable[[Any, str], Non
 THREAD_VARIABLES = ("MKL_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")
 
 
-def _init_worker(threads: int) -> None:
-    """A local worker: Ctrl-C is the parent's to handle, and the math libraries use `threads` threads (unless the
+def _init_worker(threads: int, heavy_lock) -> None:
+    """A local worker: Ctrl-C is the parent's to handle, the math libraries use `threads` threads (unless the
     caller's environment sets their variables): in the environment for MKL, which loads later, and through
-    threadpoolctl for what the worker's imports already loaded (NumPy's OpenBLAS)."""
+    threadpoolctl for what the worker's imports already loaded (NumPy's OpenBLAS); and the pool's workers share
+    `heavy_lock`, so that one of them at a time runs a memory-heavy stage (`run.heavy_stage`)."""
     from threadpoolctl import threadpool_limits
 
     ignore_sigint()
+    install_heavy_lock(heavy_lock)
     unset = [name for name in THREAD_VARIABLES if name not in os.environ]
     os.environ.update({name: str(threads) for name in unset})
     if unset:

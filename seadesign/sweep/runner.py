@@ -27,6 +27,7 @@ from seadesign.run.fingerprint import code_fingerprint
 from seadesign.run.atomic import atomic_write
 from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.executors import default_jobs, execute
+from seadesign.run.heavy_stage import heavy_stage_busy
 from seadesign.run.interrupt import Interrupted, remove_partial_files
 from seadesign.run.progress import ProgressDisplay
 from seadesign.sweep.path_stage import path_key, path_response
@@ -98,11 +99,16 @@ def evaluate(job: Job, sink) -> dict:
             row.update(status="invalid", reason="; ".join(checked.reasons))
         elif not job.screen:
             part_of = part_source(job.study, checked, part, stage)
+
+            def path():
+                return path_response(job.study, checked, part_of, job.settings, job.cache, stage)
+
+            early = path() if heavy_stage_busy() else None  # another worker factors: the path first, not a wait
             unit = fea_response(job.study, checked, part_of, job.settings, job.cache, stage)
             coarse = (coarse_k(job.study, checked, part_of, job.settings, job.cache, stage)
                       if job.settings.k_error_estimate else None)
             row.update(fea_columns(unit, coarse, job.study))
-            row.update(path_columns(path_response(job.study, checked, part_of, job.settings, job.cache, stage), job.study))
+            row.update(path_columns(early or path(), job.study))
     except Exception as exc:  # noqa: BLE001 - a failing candidate is a result, not a crash
         row.update(status="failed", reason=f"{type(exc).__name__}: {exc}".strip(),
                    traceback=traceback.format_exc(limit=4))

@@ -29,6 +29,7 @@ from seadesign.design.candidate import Candidate
 from seadesign.design.study import Study
 from seadesign.run.cache import Cache, digest, package_versions
 from seadesign.run.fingerprint import code_fingerprint
+from seadesign.run.heavy_stage import heavy_stage
 
 if TYPE_CHECKING:
     from seadesign.design.geometry import Part
@@ -169,7 +170,8 @@ def fea_response(study: Study, candidate: Candidate, part: Callable[[], Part], s
         progress("mesh")
         mesh = tetrahedralize(study, candidate, part(), cache)
         progress("fea")
-        unit = unit_response(mesh, study, candidate, settings)
+        with heavy_stage():  # the sweep's largest factorization: one worker at a time
+            unit = unit_response(mesh, study, candidate, settings)
         cache.put("fea", fkey, unit)
     return replace(unit, results=unit.results.with_modulus(candidate.material.youngs_modulus_Pa / REFERENCE_MODULUS_PA))
 
