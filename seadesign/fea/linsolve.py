@@ -2,9 +2,9 @@
 Matrices arrive as their upper triangle (scalar CSR or block BSR with full diagonal blocks).
 
 Mixed precision (`precision="mixed"`, PARDISO only): the factors in single precision precondition SciPy's conjugate
-gradients on the matrix in double precision, to a residual of MIXED_RTOL of the load. On the default study's 8 x 4
-mm part (462k unknowns, one thread) the factors take 1.0 GiB instead of 2.0 GiB and 8.6 s instead of 10.5-14 s, and
-five iterations give the double-precision factors' solution to 3e-13 (docs/validation/linear-fea.md). A matrix
+gradients on the matrix in double precision, to a residual of MIXED_RTOL of the load: on the default study's result
+meshes in about five iterations, with less memory and time than double-precision factors and their solution to
+1e-11 (docs/validation/linear-fea.md#mixed-precision, benchmarks/linear_solve.py). A matrix
 too ill-conditioned for single precision (its single-precision factorization meets a non-positive pivot, or the
 iterations do not converge) is factored in double precision instead: the answer never depends on the precision.
 """
@@ -39,6 +39,7 @@ class SPDFactorization:
             raise SolverError(f"precision {precision!r} with backend {backend!r}: use 'double', or 'mixed' with "
                               "'pardiso'")
         self._mixed = _SymmetricUpper(upper) if precision == "mixed" else None
+        self.iterations = 0  # conjugate-gradient iterations of the mixed-precision solves so far
         if backend == "pardiso":
             from seadesign.fea.pardiso import Pardiso
 
@@ -80,7 +81,7 @@ class SPDFactorization:
         m = sla.LinearOperator((self.n, self.n), self._solver.solve)
         columns = []
         for column in b.reshape(self.n, -1).T:
-            x, info = sla.cg(a, column, rtol=MIXED_RTOL, atol=0.0, maxiter=MIXED_MAXITER, M=m)
+            x, info = sla.cg(a, column, rtol=MIXED_RTOL, atol=0.0, maxiter=MIXED_MAXITER, M=m, callback=self._count)
             if info != 0:  # too ill-conditioned for single-precision factors
                 from seadesign.fea.pardiso import Pardiso
 
@@ -90,6 +91,9 @@ class SPDFactorization:
                 return self._solver.solve(b)
             columns.append(x)
         return np.stack(columns, axis=1).reshape(b.shape)
+
+    def _count(self, _x: np.ndarray) -> None:
+        self.iterations += 1
 
 
 class _SymmetricUpper:
