@@ -108,7 +108,7 @@ def evaluate(job: Job, sink) -> dict:
             coarse = (coarse_k(job.study, checked, part_of, job.settings, job.cache, stage)
                       if job.settings.k_error_estimate else None)
             row.update(fea_columns(unit, coarse, job.study))
-            row.update(path_columns(early or path(), job.study))
+            row.update(path_columns(path() if early is None else early, job.study))
     except Exception as exc:  # noqa: BLE001 - a failing candidate is a result, not a crash
         row.update(status="failed", reason=f"{type(exc).__name__}: {exc}".strip(),
                    traceback=traceback.format_exc(limit=4))
