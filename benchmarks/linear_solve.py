@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/linear_solve.py [--candidates 8x4,6x8,3x4] [--repeats 2] [--docs]
 Per candidate: the condensed stiffness of the unit torsion problem on the study's result mesh (as
-`fea.torsion.solve_unit_torsion` assembles it), factored and solved by `fea.linsolve.SPDFactorization` in
+`fea.torsion.torsion_problem` assembles it), factored and solved by `fea.linsolve.SPDFactorization` in
 double precision (PARDISO's Cholesky) and in mixed precision (single-precision factors preconditioning conjugate
 gradients in double), alternated `--repeats` times in one process on the current MKL threads: the least time of
 each, the largest growth of the resident memory while it runs (sampled every 10 ms; MKL holds the factors outside
@@ -23,11 +23,8 @@ import psutil
 from record import Table, add_docs_option, machine, write_fragment
 
 from seadesign.design.study import load_study
-from seadesign.fea.assembly import stiffness_upper
-from seadesign.fea.couplings import couple
-from seadesign.fea.elements import element_mesh
 from seadesign.fea.linsolve import SPDFactorization
-from seadesign.fea.torsion import MM, default_boundaries, surface_nodes
+from seadesign.fea.torsion import torsion_problem
 from seadesign.run.cache import Cache
 from seadesign.sweep.stages import REFERENCE_MODULUS_PA, tetrahedralize
 
@@ -52,20 +49,6 @@ class PeakMemory:
         self._running = False
         self._thread.join()
         self.growth = self.peak - self._start
-
-
-def unit_torsion_system(mesh, poisson_ratio: float):
-    """(condensed upper stiffness, unit-torque load, index of the hub's rotation) as the linear solve sees them."""
-    emesh = element_mesh(mesh.points_mm * MM, mesh.tets, 2)
-    hub_names, ring_names = default_boundaries(mesh)
-    hub = np.unique(np.concatenate([surface_nodes(emesh, mesh.boundary_faces[mesh.boundaries[n]]) for n in hub_names]))
-    ring = surface_nodes(emesh, np.concatenate([mesh.boundary_faces[mesh.boundaries[n]] for n in ring_names]))
-    z = mesh.points_mm[:, 2]
-    cpl = couple(emesh.nodes_m, hub, ring, np.array([0.0, 0.0, 0.5 * (z.min() + z.max()) * MM]))
-    k = cpl.condense(stiffness_upper(emesh, REFERENCE_MODULUS_PA, poisson_ratio, cpl.node_index, cpl.n_rows)).matrix()
-    rhs = np.zeros(k.shape[0])
-    rhs[cpl.ref_dofs[5]] = 1.0
-    return k, rhs, cpl.ref_dofs[5]
 
 
 def solve(k, rhs, precision: str) -> tuple[float, int, int, np.ndarray]:
@@ -93,7 +76,8 @@ def main() -> None:
             n, t = spec.split("x")
             checked, part = study.check(study.candidate(beam_count=int(n), beam_thickness_mm=float(t)))
             mesh = tetrahedralize(study, checked, part, Cache(Path(d)))
-            k, rhs, rotation = unit_torsion_system(mesh, checked.material.poisson_ratio)
+            problem = torsion_problem(mesh, REFERENCE_MODULUS_PA, checked.material.poisson_ratio)
+            k, rhs, rotation = problem.stiffness.matrix(), problem.unit_load(), problem.coupling.ref_dofs[5]
             runs = {"double": [], "mixed": []}
             for _ in range(args.repeats):
                 for precision in runs:

@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from seadesign.fea.assembly import nodal_forces, stiffness_upper
-from seadesign.fea.couplings import couple
+from seadesign.fea.assembly import UpperBlocks, nodal_forces, stiffness_upper
+from seadesign.fea.couplings import RigidCoupling, couple
 from seadesign.fea.elements import ElementMesh, element_mesh, midside_nodes
 from seadesign.fea.linsolve import SPDFactorization
 from seadesign.mesh.tetmesh import TetMesh
@@ -58,17 +58,33 @@ def default_boundaries(mesh: TetMesh) -> tuple[list[str], list[str]]:
     return hub or ["bore"], ring or ["outer"]
 
 
-def solve_unit_torsion(
-    mesh: TetMesh,
-    youngs_modulus_Pa: float,
-    poisson_ratio: float,
-    hub_boundaries: list[str] | None = None,
-    ring_boundaries: list[str] | None = None,
-    order: int = 2,
-    linear_solver: str = "pardiso",
-) -> UnitTorsion:
-    """Assemble, couple, factor once and solve for 1 Nm on the hub (reference point on the axis
-    at mid-thickness, its other five dofs free)."""
+@dataclass(frozen=True)
+class TorsionProblem:
+    """The unit torsion problem assembled: the coupled surfaces and the condensed stiffness (N/m, N/rad, Nm/rad in
+    its translation and rotation entries), with the seconds its set-up and assembly took."""
+
+    emesh: ElementMesh
+    coupling: RigidCoupling
+    stiffness: UpperBlocks
+    hub_groups: dict[str, np.ndarray]
+    hub_nodes: np.ndarray
+    ring_nodes: np.ndarray
+    ref_m: np.ndarray
+    setup_s: float
+    assembly_s: float
+
+    def unit_load(self) -> np.ndarray:
+        """The condensed load of 1 Nm about +z on the hub's reference point."""
+        rhs = np.zeros(3 * self.stiffness.n)
+        rhs[self.coupling.ref_dofs[5]] = 1.0
+        return rhs
+
+
+def torsion_problem(mesh: TetMesh, youngs_modulus_Pa: float, poisson_ratio: float,
+                    hub_boundaries: list[str] | None = None, ring_boundaries: list[str] | None = None,
+                    order: int = 2) -> TorsionProblem:
+    """Couple the hub surfaces to a reference point on the axis at mid-thickness (its six dofs free), hold the
+    ring surfaces, and assemble and condense the stiffness (defaults: `default_boundaries`)."""
     t0 = time.perf_counter()
     default_hub, default_ring = default_boundaries(mesh)
     hub_boundaries = hub_boundaries or default_hub
@@ -88,27 +104,41 @@ def solve_unit_torsion(
 
     cpl = couple(emesh.nodes_m, hub_nodes, ring_nodes, ref_m)
     k = cpl.condense(stiffness_upper(emesh, youngs_modulus_Pa, poisson_ratio, cpl.node_index, cpl.n_rows))
+    return TorsionProblem(emesh, cpl, k, hub_groups, hub_nodes, ring_nodes, ref_m, t1 - t0, time.perf_counter() - t1)
+
+
+def solve_unit_torsion(
+    mesh: TetMesh,
+    youngs_modulus_Pa: float,
+    poisson_ratio: float,
+    hub_boundaries: list[str] | None = None,
+    ring_boundaries: list[str] | None = None,
+    order: int = 2,
+    linear_solver: str = "pardiso",
+) -> UnitTorsion:
+    """Assemble, couple, factor once and solve for 1 Nm on the hub (`torsion_problem`)."""
+    problem = torsion_problem(mesh, youngs_modulus_Pa, poisson_ratio, hub_boundaries, ring_boundaries, order)
+    emesh, cpl, k = problem.emesh, problem.coupling, problem.stiffness
     t2 = time.perf_counter()
 
     precision = "mixed" if linear_solver == "pardiso" else "double"  # PARDISO: half the factors' memory
     fact = SPDFactorization(k.matrix(), backend=linear_solver, precision=precision)
     t3 = time.perf_counter()
 
-    rhs = np.zeros(3 * k.n)
-    rhs[cpl.ref_dofs[5]] = 1.0  # 1 Nm about +z
-    q = fact.solve(rhs)
+    q = fact.solve(problem.unit_load())
     fact.close()
     u = cpl.displacements(q)
-    f = nodal_forces(emesh, u, youngs_modulus_Pa, poisson_ratio, np.union1d(hub_nodes, ring_nodes))
+    f = nodal_forces(emesh, u, youngs_modulus_Pa, poisson_ratio, np.union1d(problem.hub_nodes, problem.ring_nodes))
     t4 = time.perf_counter()
     return UnitTorsion(
         emesh=emesh,
         displacement_m=u,
         hub_motion=q[cpl.ref_dofs],
         nodal_force_N=f,
-        ref_m=ref_m,
-        hub_groups=hub_groups,
-        ring_nodes=ring_nodes,
+        ref_m=problem.ref_m,
+        hub_groups=problem.hub_groups,
+        ring_nodes=problem.ring_nodes,
         n_dofs=3 * k.n,
-        timings_s={"setup": t1 - t0, "assembly": t2 - t1, "factorization": t3 - t2, "solve": t4 - t3},
+        timings_s={"setup": problem.setup_s, "assembly": problem.assembly_s, "factorization": t3 - t2,
+                   "solve": t4 - t3},
     )
