@@ -153,8 +153,12 @@ def main() -> None:
         print(f"largest path-mesh overestimate: {name} at strain {level:g}: x {worst:.4f}; knock-down on the path's "
               f"strain-limit torques: {min(1.0, 1.0 / worst):.4f}")
     if args.docs and args.contact:  # candidates on one mesh, or one candidate's meshes against each other
-        write_fragment("path_convergence_contact" + ("_meshes" if len(meshes) > 1 else ""), through, f"Study {st.name}; meshes {args.meshes} (path: the "
-                       f"sweep's path mesh, 1: the result mesh); through frictionless self-contact")
+        contact_text = (f"Study {st.name}; meshes {args.meshes} (path: the sweep's path mesh, 1: the result mesh); "
+                        "through frictionless self-contact")
+        if len(meshes) > 1:
+            write_fragment("path_convergence_contact_meshes", through, contact_text)
+        else:
+            write_fragment("path_convergence_contact", through, contact_text)
     elif args.docs:
         settings_text = (f"Study {st.name}; meshes {args.meshes} (a number: that coarsening of the study's mesh, 1 the "
                          f"result mesh; path: the sweep's path mesh); largest step {settings.max_step_rad:g} rad")
