@@ -47,8 +47,8 @@ def test_a_solver_change_recomputes_the_fea_and_reuses_the_geometry(tmp_path):
     # the solver now applies 2 Nm where it says 1 Nm: every k halves if it is recomputed
     torsion = src / "seadesign" / "fea" / "torsion.py"
     text = torsion.read_text()
-    assert text.count("rhs[cpl.ref_dofs[5]] = 1.0") == 1
-    torsion.write_text(text.replace("rhs[cpl.ref_dofs[5]] = 1.0", "rhs[cpl.ref_dofs[5]] = 2.0"))
+    assert text.count("rhs[self.coupling.ref_dofs[5]] = 1.0") == 1
+    torsion.write_text(text.replace("rhs[self.coupling.ref_dofs[5]] = 1.0", "rhs[self.coupling.ref_dofs[5]] = 2.0"))
     after = _sweep(src, study, tmp_path / "out1", cache)
 
     assert _entries(cache, "geometry") == geometry  # geometry verdicts reused
