@@ -101,8 +101,8 @@ def main() -> None:
     ap.add_argument("--no-ccx", action="store_true")
     ap.add_argument("--no-path", action="store_true", help="skip the large-deflection path")
     ap.add_argument("--max-rotation-rad", type=float, default=0.4, help="where the path stops at the latest")
-    ap.add_argument("--contact", action="store_true", help="the path through frictionless self-contact (the study's "
-                    "self_contact), and CalculiX with a face-to-face contact pair where ours touches at the end")
+    ap.add_argument("--contact", action="store_true", help="the path through frictionless self-contact (the sweep's "
+                    "setting), and CalculiX with a face-to-face contact pair where ours touches at the end")
     args = ap.parse_args()
     st = load_study(args.study)
     sizing = st.mesh.scaled(1.0 / args.coarsening)

@@ -17,7 +17,7 @@ and level: the knock-down the sweep applies to the path's strain-limit torques (
 STRAIN_TORQUE_KNOCKDOWN`).
 
 `--contact`: the path goes on through frictionless self-contact (`fea.rotation_path.through_contact`, the sweep's
-setting with `[ranking] self_contact`); each mesh's row then also gives first contact (rad, Nm), why and where contact
+setting); each mesh's row then also gives first contact (rad, Nm), why and where contact
 ended the path if it ended unconverged, and at the last listed rotation the peak tensile strain with its distance
 (mm, at rest) from where the contact presses hardest: the strain in the contact zone when that distance is small.
 `--docs` then writes docs/validation/_fragments/path_convergence_contact.md, or with more than one mesh
@@ -74,7 +74,7 @@ def main() -> None:
     ap.add_argument("--max-step-rad", type=float, default=PathSettings().max_step_rad,
                     help="the path's largest step (rad): smaller steps check that no narrow instability is stepped over")
     ap.add_argument("--contact", action="store_true", help="through frictionless self-contact (the sweep's "
-                    "self_contact setting)")
+                    "setting)")
     add_docs_option(ap, "path_convergence", "strain_knockdown", "path_convergence_contact",
                     "path_convergence_contact_meshes")
     args = ap.parse_args()

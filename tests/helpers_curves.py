@@ -21,7 +21,7 @@ def with_limits(study: Study, cyclic: float | None, elongation: float | None = 0
 
 
 def linear_row(study: Study, i: int, name: str, k: float, strain_per_rad: float, stop_Nm: float | None = None,
-               mass_g: float = 20.0, reason: str = "contact") -> dict:
+               mass_g: float = 20.0, reason: str = "unconverged") -> dict:
     """A solved candidate with T = k theta to the impact torque, or to `stop_Nm` (stop `reason`)."""
     lc, m = study.load_cases, study.material
     cyclic = math.nan if m.cyclic_strain_limit is None else m.cyclic_strain_limit

@@ -143,10 +143,10 @@ def test_the_wall_clock_cap_is_the_cli_s_and_the_library_has_none(tmp_path, spri
 
 
 def _with_curve(spring_dict: dict, end_Nm: float, hard_stop: bool = False) -> dict:
-    """The spring with a linear torque curve T = k theta that ends at `end_Nm`."""
+    """The spring with a linear torque curve T = k theta that ends at `end_Nm`, at first contact (a schema-2 file)."""
     k = spring_dict["k_Nm_per_rad"]
     theta = [0.0, 0.5 * end_Nm / k, end_Nm / k]
-    return {**spring_dict, "torque_curve": {"rotation_rad": theta, "torque_Nm": [k * t for t in theta],
+    return {**spring_dict, "schema_version": 2, "torque_curve": {"rotation_rad": theta, "torque_Nm": [k * t for t in theta],
                                             "source": "fea_large_deflection", "stop_reason": "contact",
                                             "hard_stop": hard_stop}}
 
@@ -167,14 +167,13 @@ def test_train_refuses_before_training_a_spring_whose_curve_ends_before_the_prot
     text = " ".join(res.output.split())
     assert "the spring cannot carry what training needs: the simulator's ground protocol loads the spring to" in text
     assert "Its torque curve ends at" in text and "1 Nm (stop reason contact" in text and "Remedy:" in text
-    assert "the path through frictionless self-contact can go on past it (`seadesign sweep STUDY " \
-           "--handoff-through-contact` hands on the chosen design's" in text
+    assert "(a schema-2 file): `seadesign sweep` now hands on the path through frictionless self-contact" in text
     assert not (tmp_path / "m").exists()
     bifurcating = _with_curve(spring_dict, 1.0)
     bifurcating["torque_curve"]["stop_reason"] = "bifurcation"
     with pytest.raises(SpringRangeError) as refusal:
         check_spring_range(bifurcating)
-    assert "Remedy:" in str(refusal.value) and "self_contact" not in str(refusal.value)  # contact is not its end
+    assert "Remedy:" in str(refusal.value) and "self-contact" not in str(refusal.value)  # contact is not its end
     check_spring_range(_with_curve(spring_dict, 1.01 * max(load.torque_Nm for load in loads)))  # reaches past: passes
     check_spring_range(_with_curve(spring_dict, 1.0, hard_stop=True))  # the end stop carries the rest
 

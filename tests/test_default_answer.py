@@ -1,12 +1,12 @@
 """The default study end to end, as a user runs it: `seadesign sweep`, then `seadesign train` on its spring.json.
 
-The answer is pinned to the printed digits (relative 1e-3): the choice, its stop, the runner-up and the blocking
-requirement. Later work that moves them (contact in the path, a calibrated material) updates these pins and the
-published figures on purpose. The handoff either trains or refuses before training; the default spring's curve
-ends before the simulator's ground protocol loads it, so training in the simulator is refused, with and without the
-reference recordings, naming the load, where the curve ends and why, and the remedy; a network trained on the
-recordings needs only k, and goes through train and evaluate. Slow: the full default sweep (about 8 minutes
-cold on 2 cores; the stage cache makes a rerun take seconds)."""
+The answer is pinned to the printed digits (relative 1e-3): the choice, its end, the runner-up, every candidate's
+end reason and the blocking requirement. Later work that moves them (a calibrated material, a faster path through
+contact whose crease ends elsewhere) updates these pins and the published figures on purpose. Every path goes on
+through frictionless self-contact, so the chosen spring's curve reaches past what the simulator's ground protocol
+loads it to, and `train`'s range check passes; a network trained on the reference recordings goes through train
+and evaluate. Slow: the full default sweep (about 28 minutes cold on 2 cores; the stage cache makes a rerun take
+seconds)."""
 
 from __future__ import annotations
 
@@ -23,10 +23,13 @@ from seadesign.sweep.rank import blocking
 from tests.conftest import SHARED
 
 RECORDINGS = [SHARED / "data" / "deepsea" / name for name in ("free_dtest_part1.csv", "ground_dtest_part1.csv")]
+BUCKLING = {"4 beams x 6 mm", "8 beams x 6 mm"}  # a bifurcation before their notches close; the rest end in a crease
 
 
 @pytest.mark.slow
 def test_the_default_study_answer_and_its_handoff(tmp_path):
+    from seadesign.corrector.preflight import check_spring_range
+
     out = tmp_path / "exports"
     result = CliRunner().invoke(main, ["sweep", "--quiet", "--out", str(out)])
     assert result.exit_code == 0, result.output
@@ -34,65 +37,62 @@ def test_the_default_study_answer_and_its_handoff(tmp_path):
                                           "torque (11.7 Nm); carries the impact torque (27.7 Nm); impact tensile "
                                           "strain within the single-event limit)")
     ranked = pd.read_parquet(out / "wolfgang_knee" / "results.parquet")
-    assert not ranked["feasible"].any() and not ranked["conditional"].any()
+    solved = ranked[ranked["status"] == "ok"]
+    assert len(solved) == 18 and not ranked["feasible"].any() and not ranked["conditional"].any()
+    # no path ends at contact; none carries the stall or the impact torque
+    ends = dict(zip(solved["candidate"], solved["large_stop_reason"]))
+    assert ends == {name: "bifurcation" if name in BUCKLING else "unconverged" for name in ends}
+    assert solved["large_stall_rotation_rad"].isna().all() and solved["large_impact_rotation_rad"].isna().all()
+    assert solved.loc[~solved["candidate"].isin(BUCKLING), "large_contact_rotation_rad"].notna().all()
     best, second = (ranked[ranked["rank"] == r].iloc[0] for r in (1, 2))
-    assert best["candidate"] == "6 beams x 8 mm" and second["candidate"] == "8 beams x 6 mm"
-    assert best["large_stop_reason"] == "contact"
-    assert best["large_stop_rotation_rad"] == pytest.approx(0.229, rel=1e-3)
-    assert best["large_stop_torque_Nm"] == pytest.approx(7.10, rel=1e-3)
-    assert second["large_stop_reason"] == "bifurcation"
-    assert second["large_stop_torque_Nm"] == pytest.approx(6.83, rel=1e-3)
+    assert best["candidate"] == "6 beams x 8 mm" and second["candidate"] == "5 beams x 8 mm"
+    assert best["large_contact_rotation_rad"] == pytest.approx(0.2572, rel=1e-3)
+    assert best["large_contact_torque_Nm"] == pytest.approx(7.827, rel=1e-3)
+    assert best["large_stop_rotation_rad"] == pytest.approx(0.3997, rel=1e-3)
+    assert best["large_stop_torque_Nm"] == pytest.approx(10.85, rel=1e-3)
+    assert second["large_stop_torque_Nm"] == pytest.approx(8.024, rel=1e-3)
     # what blocks it, worst first: the impact's tensile strain passes elongation at yield / 1.5 far below the load
     assert blocking(best, load_study()).startswith("impact tensile strain within the single-event limit (by 83.4 %)")
     spring_path = out / "wolfgang_knee" / "spring.json"
-    selection = json.loads(spring_path.read_text())["selection"]
-    assert selection["meets_requirements"] is False and selection["conditional"] is False
+    spring = json.loads(spring_path.read_text())
+    assert spring["schema_version"] == 3 and spring["torque_curve"]["stop_reason"] == "unconverged"
+    assert spring["torque_curve"]["torque_Nm"][-1] == pytest.approx(10.85, rel=1e-3)
+    assert spring["selection"]["meets_requirements"] is False and spring["selection"]["conditional"] is False
+    check_spring_range(spring)  # the simulator's protocol loads are on the curve: train does not refuse it
 
     data = [arg for path in RECORDINGS if path.exists() for arg in ("--data", str(path))]
-    for extra in ([], data) if data else ([],):
-        refused = CliRunner().invoke(main, ["train", "--spring", str(spring_path), "-o", str(tmp_path / "m"), *extra])
-        text = " ".join(refused.output.split())
-        assert refused.exit_code == 2, refused.output
-        assert "the spring cannot carry what training needs: the simulator's ground protocol" in text
-        assert "Its torque curve ends at 0.229 rad, 7.099 Nm (stop reason contact" in text and "Remedy:" in text
-        assert not (tmp_path / "m").exists()
     if not data:
         pytest.skip(f"train with --data: the reference recordings are not present ({RECORDINGS[0].parent})")
-    # a network trained on the recordings needs only the spring's k: the chain goes through train and evaluate
+    # a network trained on the recordings: the chain goes through train and evaluate
     trained = CliRunner().invoke(main, ["train", "--spring", str(spring_path), "--model", "mlp", "--max-epochs", "5",
                                         "-o", str(tmp_path / "mlp"), *data])
     assert trained.exit_code == 0, trained.output
-    # open loop on the recordings (the simulator's ground protocol needs more curve, as for train)
     evaluated = CliRunner().invoke(main, ["evaluate", str(tmp_path / "mlp"), *data, "--closed-loop", "none", "-o",
                                           str(tmp_path / "eval"), "--json", str(tmp_path / "eval.json")])
     assert evaluated.exit_code == 0, evaluated.output
     result = json.loads((tmp_path / "eval.json").read_text())
     mae = {r["candidate"]: r["mae_rad"] for r in result["open_loop"] if r["knee"] == "both"}
     network = next(name for name in mae if name.startswith("mlp"))
-    assert mae[network] < mae["none"] and "feedforward" not in mae
-    assert "curve ends at 0.229 rad, 7.099 Nm" in result["settings"]["feedforward_not_judged"]
-
+    assert mae[network] < mae["none"]
 
 
 @pytest.mark.long
-def test_the_default_spring_handed_on_through_contact_trains_and_evaluates(tmp_path):
-    """The chain past the refusal above, as its remedy says: `sweep --handoff-through-contact` (the default sweep's
-    rows from the stage cache, then the chosen design's path through frictionless self-contact, about 25 minutes on
-    2 cores: CI's budget cannot hold it, hence `long`), `train` with its time capped (30 s a stage) on its
-    spring.json, with and without the reference recordings, and `evaluate` of what it trained in the simulator's
-    closed loop (about 3 minutes a case). The curve now reaches past every load of the simulator's protocol, so
-    training completes where the plain sweep's spring is refused, and the trained corrector is stable and holds the
-    knee at less than half the error of the best baseline (no correction, PI, feed-forward) in both settings."""
+def test_the_default_spring_trains_and_evaluates(tmp_path):
+    """The default chain as a user runs it: `sweep` (from the stage cache after the test above), `train` with its
+    time capped (30 s a stage) on its spring.json, with and without the reference recordings, and `evaluate` of
+    what it trained in the simulator's closed loop (about 3 minutes a case; CI's budget cannot hold it, hence
+    `long`). The curve through contact reaches past every load of the simulator's protocol, and the trained
+    corrector is stable and holds the knee at less than half the error of the best baseline (no correction, PI,
+    feed-forward) in both settings."""
     from seadesign.corrector.preflight import check_spring_range
 
     out = tmp_path / "exports"
-    swept = CliRunner().invoke(main, ["sweep", "--quiet", "--handoff-through-contact", "--out", str(out)])
+    swept = CliRunner().invoke(main, ["sweep", "--quiet", "--out", str(out)])
     assert swept.exit_code == 0, swept.output
     spring_path = out / "wolfgang_knee" / "spring.json"
     spring = json.loads(spring_path.read_text())
     design, curve = spring["design"], spring["torque_curve"]
     assert (design["beam_count"], design["beam_thickness_mm"]) == (6, 8.0) and curve["stop_reason"] != "contact"
-    assert "frictionless self-contact" in spring["selection"]["curve"]
     check_spring_range(spring)  # the protocol's loads are on the curve: no refusal
     data = [arg for path in RECORDINGS if path.exists() for arg in ("--data", str(path))]
     for name, extra in [("simulator", []), ("recordings", data)][: 2 if data else 1]:

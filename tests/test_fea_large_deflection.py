@@ -58,18 +58,13 @@ def test_loads_reached_are_read_from_the_curve():
     assert math.isnan(ld.contact_rotation_rad) and ld.increments == 40 and ld.newton_iterations == 123
 
 
-def test_a_load_past_the_stop_is_not_extrapolated_unless_contact_is_an_end_stop():
+def test_a_load_past_the_stop_is_not_extrapolated():
     path = _path(0.5, "contact")  # stops at 0.5 rad, 8.29 Nm: below the stall torque
     ld = large_deflection(path, 2.0, 11.7, 14.0, LIMITS)
     assert ld.contact_rotation_rad == 0.5 and ld.contact_torque_Nm == pytest.approx(A * math.tanh(0.5 / B))
     assert ld.standing.survives
     for point in (ld.stall, ld.impact):
         assert not point.reached and not point.survives and math.isnan(point.rotation_rad)
-    stop = large_deflection(path, 2.0, 11.7, 14.0, LIMITS, contact_is_end_stop=True)
-    assert not stop.stall.reached and stop.stall.survives and stop.stall.rotation_rad == 0.5
-    assert stop.stall.tensile_strain == pytest.approx(0.25) and math.isnan(stop.stall.tangent_k_Nm_per_rad)
-    limit = large_deflection(_path(0.5, "limit_point"), 2.0, 11.7, 14.0, LIMITS, contact_is_end_stop=True)
-    assert not limit.stall.survives and math.isnan(limit.stall.rotation_rad)  # a torque maximum is no end stop
 
 
 def test_through_contact_the_event_names_first_contact_and_the_loads_their_share():

@@ -74,9 +74,21 @@ def test_bad_torque_curve_names_the_field(spring_dict, changes, problem):
         validate_spring(dict(spring_dict, schema_version=2, torque_curve=_curve(**changes)))
 
 
-@pytest.mark.parametrize("reason, end_stop, hard", [("limit_point", True, False), ("contact", False, False),
-                                                    ("contact", True, True)])
-def test_the_handed_curve_ends_at_the_paths_stop(reason, end_stop, hard):
+def test_schema_3_refuses_a_curve_that_ends_at_contact_and_schema_2_is_still_read(spring_dict):
+    """Schema 3's curves go on through self-contact: contact as their end is refused, naming the field and why;
+    a schema-2 file whose curve stopped at first contact (as an end stop, too) is still read."""
+    with pytest.raises(SpringFileError, match=r"field 'torque_curve/stop_reason': 'contact' is not allowed: schema 3 "
+                                              r"curves go on through frictionless self-contact"):
+        validate_spring(dict(spring_dict, schema_version=3, torque_curve=_curve(stop_reason="contact")))
+    old = torque_curve(validate_spring(dict(spring_dict, schema_version=2,
+                                            torque_curve=_curve(stop_reason="contact", hard_stop=True))))
+    assert old.stop_reason == "contact" and old.hard_stop
+    assert torque_curve(validate_spring(dict(spring_dict, schema_version=3, torque_curve=_curve(
+        stop_reason="unconverged")))).stop_reason == "unconverged"
+
+
+@pytest.mark.parametrize("reason", ["limit_point", "unconverged"])
+def test_the_handed_curve_ends_at_the_paths_stop(reason):
     """The sweep's row holds the converged points, the last one past the stop (a limit point is located from
     both sides); spring.json gets the points before the stop and the stop itself, a valid monotone curve."""
     import pandas as pd
@@ -87,7 +99,7 @@ def test_the_handed_curve_ends_at_the_paths_stop(reason, end_stop, hard):
     row = pd.Series({"large_curve_rotation_rad": [0.0, 0.1, 0.2, 0.3, 0.31], "large_curve_torque_Nm":
                      [0.0, 1.8, 3.2, 4.0, 3.99], "large_stop_rotation_rad": 0.303, "large_stop_torque_Nm": 4.01,
                      "large_stop_reason": reason})
-    curve = handoff_curve(row, end_stop)
+    curve = handoff_curve(row)
     assert curve["rotation_rad"] == [0.0, 0.1, 0.2, 0.3, 0.303] and curve["torque_Nm"] == [0.0, 1.8, 3.2, 4.0, 4.01]
-    assert curve["stop_reason"] == reason and curve["hard_stop"] is hard
+    assert curve["stop_reason"] == reason and curve["hard_stop"] is False
     TorqueCurve.from_handoff(curve)  # strictly increasing from (0, 0)

@@ -45,7 +45,7 @@ ROWS = [  # name, k (Nm/rad), tensile strain per rad, stop torque (Nm; None: the
     ("T", 70.0, 0.2, None, 20.0),  # one count 0.107 Nm: too stiff for the sensor
     ("H", 50.0, 1.0, None, 20.0),  # stall strain 0.234 > 0.2 cyclic, impact 0.554 > 0.433
     ("F", 5.0, 0.01, None, 10.0),  # too soft: sags 23.7 deg standing, 3.56 Hz
-    ("K", 25.0, 0.2, 6.0, 20.0),  # contact at 6 Nm: carries neither stall nor impact
+    ("K", 25.0, 0.2, 6.0, 20.0),  # ends at 6 Nm: carries neither stall nor impact
 ]
 
 
@@ -132,7 +132,7 @@ def test_when_nothing_is_feasible_the_report_names_the_block(study):
     assert by.loc["Q", "total_violation"] == pytest.approx(2 - 8 / 11.7 - 8 / study.load_cases.impact_torque_Nm)
     assert "NOT a recommendation" in c.explanation
     assert "misses carries the impact torque (27.7 Nm) (by 71.1 %); carries the stall torque" in c.explanation
-    assert "contact carrying the load" in c.explanation
+    assert "its path ends unconverged before a load: a stiffer material or a larger envelope" in c.explanation
 
 
 def test_a_strike_the_curve_cannot_store_misses_protection(study):
@@ -214,5 +214,8 @@ def test_what_would_unblock_a_design_says_where_contact_ended_its_path():
                                    "(contact unconverged at 0.4235 rad, at x 1.9, y 14.0 mm): a stiffer material or "
                                    "a larger envelope.")
     plain = row.drop(["large_unconverged_cause"]).copy()
-    assert unblock(plain, study) == ("What would unblock it: its path ends in unconverged before a load: a stiffer "
+    assert unblock(plain, study) == ("What would unblock it: its path ends unconverged before a load: a stiffer "
                                      "material or a larger envelope.")
+    buckled = plain.copy()
+    buckled["large_stop_reason"] = "bifurcation"
+    assert unblock(buckled, study).startswith("What would unblock it: its path ends in a bifurcation before a load")

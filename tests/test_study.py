@@ -7,7 +7,6 @@ from pathlib import Path
 import pytest
 
 from seadesign.errors import ConfigError
-from seadesign.fea.contact import ContactSettings
 from seadesign.design.study import DEFAULT_STUDY, load_study
 
 
@@ -23,14 +22,6 @@ def test_default_study():
     assert all(c.params.hub_radius_mm == 14.0 for c in s.candidates())
     hub = s.candidates()[0].params.hub_bolts
     assert (hub.count, hub.circle_diameter_mm) == (8, 22.0)
-
-
-def test_self_contact_sets_the_path_through_contact(tmp_path):
-    from seadesign.sweep.path_stage import path_settings
-
-    assert path_settings(load_study()).contact is None
-    on = load_study(_variant(tmp_path, r"^self_contact = false", "self_contact = true"))
-    assert on.ranking.self_contact and path_settings(on).contact == ContactSettings()
 
 
 def test_bitbots_study_loads():
@@ -62,9 +53,10 @@ def _variant(tmp_path: Path, old: str, new: str) -> Path:
         (r"^beam_thickness_mm = \[4.0, 6.0, 8.0\]", "beam_thickness_mm = [4.0, 12.0]",
          "design_space.beam_thickness_mm value 12 mm needs geometry.arc_radius_mm > 6 mm"),
         (r"^safety_factor = 1.5", "safety_factor = 0.5", "ranking.safety_factor must be >= 1"),
-        (r"^contact_is_end_stop = false(.*)\nself_contact = false", r"contact_is_end_stop = true\1\nself_contact = true",
-         "ranking.contact_is_end_stop and self_contact = true exclude each other"),
-        (r"^self_contact = false", "self_contact = 1", "ranking.self_contact must be true or false"),
+        (r"^(knee_inertia_kg_m2 = .*)$", r"\1\ncontact_is_end_stop = true", "ranking.contact_is_end_stop is no "
+         "longer used: the path goes on through frictionless self-contact .* remove the line"),
+        (r"^(knee_inertia_kg_m2 = .*)$", r"\1\nself_contact = false", "ranking.self_contact is no longer used: the "
+         "path always goes on through frictionless self-contact .* remove the line"),
     ],
 )
 def test_bad_study_is_refused_naming_the_key(tmp_path, old, new, message):

@@ -33,13 +33,8 @@ from seadesign.design.study import DEFAULT_STUDY
               help="Stage cache directory; default $SEADESIGN_CACHE or ~/.cache/seadesign.")
 @click.option("--tolerance-mm", type=click.FloatRange(min=1e-4, max=1.0), default=0.01, show_default=True,
               help="STL chordal tolerance in mm.")
-@click.option("--handoff-through-contact", is_flag=True,
-              help="Where the chosen design's path stops at contact, hand on in spring.json its curve through "
-                   "frictionless self-contact (one more path, 10-20 minutes on 2 cores), e.g. for `seadesign train`; "
-                   "the ranking stays that of the paths without contact forces.")
 def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: str | None, export_all: bool,
-          out_dir: Path, calibration: Path | None, cache_dir: Path | None, tolerance_mm: float,
-          handoff_through_contact: bool) -> None:
+          out_dir: Path, calibration: Path | None, cache_dir: Path | None, tolerance_mm: float) -> None:
     """Run every candidate of STUDY (geometry, validity, mesh, both linear load cases, the large-deflection
     torque path), rank them on the paths and write results.parquet/csv, plots, report.html/md, STL/STEP and spring.json to OUT/<study>/.
 
@@ -53,8 +48,7 @@ def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: s
     resume = "seadesign " + shlex.join(sys.argv[1:])
     try:
         with stop_on_signals():
-            _sweep(study, jobs, quiet, executor, scheduler, export_all, out_dir, calibration, cache_dir, tolerance_mm,
-                   handoff_through_contact)
+            _sweep(study, jobs, quiet, executor, scheduler, export_all, out_dir, calibration, cache_dir, tolerance_mm)
     except SweepStopped as stop:
         click.echo(f"stopped by {stop.signal}: {stop.saved} of {stop.total} candidates finished and saved in "
                    f"{stop.rows_dir} (no half-written file left); resume with: {resume}", err=True)
@@ -65,8 +59,7 @@ def sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: s
 
 
 def _sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: str | None, export_all: bool,
-           out_dir: Path, calibration: Path | None, cache_dir: Path | None, tolerance_mm: float,
-           handoff_through_contact: bool) -> None:
+           out_dir: Path, calibration: Path | None, cache_dir: Path | None, tolerance_mm: float) -> None:
     """The sweep command's work (`sweep.pipeline`; see `sweep`)."""
     from seadesign.design.study import load_study
     from seadesign.sweep.pipeline import apply_calibration, sweep_and_write
@@ -80,6 +73,6 @@ def _sweep(study: str, jobs: int | None, quiet: bool, executor: str, scheduler: 
         click.echo(note)
     result = sweep_and_write(s, out_dir, baseline=baseline, jobs=jobs, quiet=quiet, executor=executor,
                              scheduler=scheduler, export_all=export_all, cache_dir=cache_dir, tolerance_mm=tolerance_mm,
-                             calibration_note=note, handoff_through_contact=handoff_through_contact)
+                             calibration_note=note)
     for line in result.lines(quiet):
         click.echo(line)

@@ -24,7 +24,7 @@ import pandas as pd
 
 from seadesign.corrector.closedloop import ClosedLoopRun, closed_loop_table, trial_label
 from seadesign.corrector.runtime import Corrector
-from seadesign.design.spring import torque_curve
+from seadesign.design.spring import SCHEMA_VERSION, torque_curve
 from seadesign.twin import Gait, KneeConfig, Trial, knee_effects
 
 GOAL_REDUCTION = 0.30
@@ -52,7 +52,7 @@ def softening_curve(spring: dict[str, Any]) -> dict[str, Any]:
     curve = {"rotation_rad": theta.tolist(), "torque_Nm": (a * np.tanh(theta * k / a)).tolist(),
              "source": "robustness case: tanh softening to the stall torque", "stop_reason": "target_reached",
              "hard_stop": False}
-    return {**spring, "schema_version": 2, "torque_curve": curve}
+    return {**spring, "schema_version": SCHEMA_VERSION, "torque_curve": curve}
 
 
 def robustness_cases(spring: dict[str, Any]) -> list[Case]:

@@ -72,10 +72,9 @@ def _refusal(spring: dict[str, Any], curve: TorqueCurve, beyond: list[Load]) -> 
     selection = spring.get("selection", {})
     verdict = ("" if selection.get("meets_requirements", True) else
                f" This spring does not meet its study's requirements ({selection.get('failed_constraints', '')}).")
-    through = (" Its path stopped where a gap between facing surfaces closed, without contact forces: the path "
-               "through frictionless self-contact can go on past it (`seadesign sweep STUDY --handoff-through-contact` "
-               "hands on the chosen design's, one more path of 10-20 minutes on 2 cores; `[ranking] self_contact = "
-               "true` ranks every candidate on it)." if curve.stop_reason == "contact" else "")
+    through = (" Its path stopped where a gap between facing surfaces closed, without contact forces (a schema-2 "
+               "file): `seadesign sweep` now hands on the path through frictionless self-contact, which goes on past "
+               "it." if curve.stop_reason == "contact" else "")
     return ("the spring cannot carry what training needs: " + "; ".join(load.what for load in beyond)
             + f". Its torque curve ends at {curve.end_rotation_rad:.4g} rad, {curve.end_torque_Nm:.4g} Nm (stop reason "
             f"{curve.stop_reason}: the large-deflection path ends there, and the curve is not extrapolated)."

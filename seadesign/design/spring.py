@@ -3,8 +3,10 @@ the one `TorqueCurve` type that reads, checks and interpolates its large-deflect
 
 The file is the only thing the downstream half reads. It is validated against
 `schemas/spring.schema.json` on read and on write, so a bad file is refused with the
-offending field named. Schema 2 may carry the spring's large-deflection torque curve
-(`torque_curve`, read with `torque_curve`); schema 1 files (k only) are still read.
+offending field named. Schema 3 (written) carries the spring's large-deflection torque curve through
+frictionless self-contact (`torque_curve`, read with `torque_curve`), so contact is never where it ends;
+schema 2 files (whose curve may end at first contact, possibly as a hard stop) and schema 1 files (k only)
+are still read.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from seadesign.errors import ConfigError, DataError, SpringFileError
 STOP_REASONS = (
     "target_reached", "limit_point", "bifurcation", "contact", "strain_limit", "rotation_limit", "unconverged")
 
-SCHEMA_VERSION = 2  # what the sweep writes; readers take every version the schema lists
+SCHEMA_VERSION = 3  # what the sweep writes; readers take every version the schema lists
 
 
 def spring_schema() -> dict[str, Any]:
@@ -44,7 +46,8 @@ def validate_spring(data: Any, source: str = "spring.json") -> dict[str, Any]:
             if err.validator == "required":  # name the missing key itself
                 path.append(err.message.split("'")[1])
             field = "/".join(path) or "(top level)"
-            lines.append(f"  field '{field}': {err.message}")
+            why = f"{err.instance!r} is not allowed: {err.schema['description']}" if err.validator == "not" else err.message
+            lines.append(f"  field '{field}': {why}")
         raise SpringFileError(
             f"{source} does not match the spring.json schema (seadesign/design/schemas/spring.schema.json):\n"
             + "\n".join(lines)

@@ -57,8 +57,6 @@ class Ranking:
     safety_factor: float  # the single-event allowable strain is the elongation at yield / safety_factor
     impact_speed_m_per_s: float  # foot speed at touchdown
     knee_inertia_kg_m2: float  # inertia of the link behind the spring, about the knee
-    contact_is_end_stop: bool = False  # contact closing a gap may carry torque past it (else: contact ends the travel)
-    self_contact: bool = False  # the path goes on through frictionless self-contact (else: it ends at first contact)
 
 
 @dataclass(frozen=True)
@@ -321,22 +319,25 @@ def _mesh(top: Table) -> MeshSettings:
     return mesh
 
 
+REMOVED_RANKING_KEYS = {  # [ranking] keys of earlier versions, and what replaced them
+    "small_deflection_limit_rad": "the large-deflection path replaced the small-deflection flag",
+    "contact_is_end_stop": "the path goes on through frictionless self-contact (spring.json schema 3), so a closing "
+                           "gap is no longer an end stop that carries the rest",
+    "self_contact": "the path always goes on through frictionless self-contact (spring.json schema 3)",
+}
+
+
 def _ranking(top: Table) -> tuple[Ranking, Requirements]:
     """[ranking] and [requirements] (see design/requirements.py)."""
     rk = top.table("ranking")
-    if rk.raw("small_deflection_limit_rad") is not None:
-        raise rk.error(rk.key("small_deflection_limit_rad"), "is no longer used: the large-deflection path replaced the "
-                       "small-deflection flag; remove the line")
+    for key, why in REMOVED_RANKING_KEYS.items():
+        if rk.raw(key) is not None:
+            raise rk.error(rk.key(key), f"is no longer used: {why}; remove the line")
     ranking = Ranking(
         safety_factor=rk.number("safety_factor", ge=1),
         impact_speed_m_per_s=rk.number("impact_speed_m_per_s", gt=0),
         knee_inertia_kg_m2=rk.number("knee_inertia_kg_m2", gt=0),
-        contact_is_end_stop=rk.boolean("contact_is_end_stop", False),
-        self_contact=rk.boolean("self_contact", False),
     )
-    if ranking.self_contact and ranking.contact_is_end_stop:
-        raise rk.error(rk.key("contact_is_end_stop"), "and self_contact = true exclude each other: with self-contact the "
-                       "path goes on through contact, so contact ends no travel; remove contact_is_end_stop")
     refuse_moved_keys(rk)
     rk.done()
     return ranking, read_requirements(top.table("requirements", optional=True))

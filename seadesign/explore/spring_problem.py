@@ -54,9 +54,6 @@ class SpringProblem:
     encoding: Encoding = field(init=False)
 
     def __post_init__(self) -> None:
-        if self.study.ranking.contact_is_end_stop:
-            raise ConfigError(f"{self.study.path}: ranking.contact_is_end_stop = true: the explorer reads each load "
-                              "from the travel before contact; set it to false to explore this study")
         self.encoding = Encoding(self.study.axes)
         self.objectives = tuple(OBJECTIVE_COLUMNS[o] for o in self.study.requirements.objectives)
         self.margins = tuple(r.column for r in requirement_list(self.study))

@@ -125,8 +125,7 @@ def _nan(value: float | None) -> float:
     return math.nan if value is None else float(value)
 
 
-def _load_point(path: TorquePath, theta: np.ndarray, torque_Nm: float, limit: float,
-                contact_is_end_stop: bool) -> LoadPoint:
+def _load_point(path: TorquePath, theta: np.ndarray, torque_Nm: float, limit: float) -> LoadPoint:
     """The path at one load torque; `theta` are its points' rotations (rad), `limit` the load class's
     allowable tensile strain (NaN: none)."""
     rotation = path.rotation_at(torque_Nm)
@@ -134,8 +133,6 @@ def _load_point(path: TorquePath, theta: np.ndarray, torque_Nm: float, limit: fl
     tangent = math.nan
     if reached:
         tangent = float(np.interp(rotation, theta, [p.tangent_Nm_per_rad for p in path.points]))
-    elif contact_is_end_stop and path.stop_reason == "contact" and torque_Nm > path.stop_torque_Nm:
-        rotation = path.stop_rotation_rad
     else:
         rotation = math.nan
     carried = math.isfinite(rotation)
@@ -166,7 +163,7 @@ def _load_point(path: TorquePath, theta: np.ndarray, torque_Nm: float, limit: fl
 
 
 def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_Nm: float, impact_torque_Nm: float,
-                     limits: StrainLimits, contact_is_end_stop: bool = False) -> LargeDeflection:
+                     limits: StrainLimits) -> LargeDeflection:
     """The path read at the standing, stall and impact torques (Nm) against the load classes' strain `limits`;
     see the module doc for a load the path does not reach."""
     pts = path.points
@@ -213,9 +210,9 @@ def large_deflection(path: TorquePath, standing_torque_Nm: float, stall_torque_N
         peak_compressive_at=element_location(path, worst_compression.peak_compressive_element),
         peak_von_mises_MPa=worst_stress.peak_von_mises_Pa * 1e-6,
         peak_von_mises_at=element_location(path, worst_stress.peak_von_mises_element),
-        standing=_load_point(path, theta, standing_torque_Nm, cyclic, contact_is_end_stop),
-        stall=_load_point(path, theta, stall_torque_Nm, cyclic, contact_is_end_stop),
-        impact=_load_point(path, theta, impact_torque_Nm, single, contact_is_end_stop),
+        standing=_load_point(path, theta, standing_torque_Nm, cyclic),
+        stall=_load_point(path, theta, stall_torque_Nm, cyclic),
+        impact=_load_point(path, theta, impact_torque_Nm, single),
         increments=len(pts) - 1,
         newton_iterations=sum(p.iterations for p in pts),
         cut_backs=path.cut_backs,

@@ -22,7 +22,7 @@ The path stops, and says why (`STOP_REASONS` of `design.spring`):
   carries the closed gap and the path goes on: first contact is an event (`TorquePath.events`, where
   the first pressed pair's gap closes), each point records the contact's area, peak pressure, moment
   and penetration, and an increment whose penetration the multiplier updates cannot bring within
-  the tolerance is cut back like one that does not converge (below `min_step_rad` the path ends
+  the tolerance is cut back like one that does not converge (below `contact_min_step_rad` the path ends
   unconverged, and an "unresolved_penetration" event says where); so is an increment over which the
   hub's work and the strain energy's increase differ (`path_events.energy_balanced`: frictionless
   contact stores no energy), and where that holds at every step size a "contact_energy_loss" event
@@ -30,7 +30,8 @@ The path stops, and says why (`STOP_REASONS` of `design.spring`):
   "contact_unconverged" event;
 - strain_limit: the peak tensile principal engineering strain passed the allowable strain;
 - rotation_limit: the rotation reached `max_rotation_rad` below the target torque;
-- unconverged: the increment fell below `min_step_rad` without convergence (never a capacity).
+- unconverged: the increment fell below `min_step_rad` (`contact_min_step_rad` from a point in contact)
+  without convergence (never a capacity).
 SI units throughout; mesh coordinates arrive in mm.
 """
 
@@ -56,7 +57,6 @@ from seadesign.fea.torque_path import UNCONVERGED_EVENTS, PathEvent, PathPoint, 
 from seadesign.fea.torsion import MM, surface_nodes
 from seadesign.mesh.tetmesh import TetMesh
 
-
 @dataclass(frozen=True)
 class PathSettings:
     """Increment control and stopping rules of the rotation-driven path."""
@@ -64,6 +64,9 @@ class PathSettings:
     first_step_rad: float = 0.02
     max_step_rad: float = 0.1
     min_step_rad: float = 1e-4
+    contact_min_step_rad: float = 2e-3  # the smallest step from a point in contact (first contact is approached
+    # with `min_step_rad`): where a notch creases, the end found with smaller steps scatters by more than this
+    # between runs, and the steps below it took most of the path's time (docs/validation/timing.md)
     max_rotation_rad: float = 6.0
     newton: NewtonSettings = NewtonSettings()
     force_rtol: float = 1e-7  # residual norm over the norm of the reaction forces
@@ -200,7 +203,8 @@ def rotation_path(
                     contact = next((c for c in estimates if c is not None and last.rotation_rad < c < theta), None)
                     probe = point
                 step = step * 0.5 if contact is None else bracketing_step(contact, last.rotation_rad, settings)
-                if status in ("failed", "penetrating", "losing_energy") and step < settings.min_step_rad:
+                floor = settings.contact_min_step_rad if last.contact.area_m2 > 0 else settings.min_step_rad
+                if status in ("failed", "penetrating", "losing_energy") and step < floor:
                     reason = "unconverged"
                     pressed = NO_CONTACT if p.system.contact is None else p.system.contact.summary(trial)
                     if status != "failed" or pressed.area_m2 > 0:  # where: the rotation tried, where it presses hardest

@@ -112,11 +112,15 @@ def fig_pareto(t: pd.DataFrame, chosen: int | None, path: Path) -> Path:
     return _save(fig, path)
 
 
+END_MARKERS = {"limit_point": "^", "bifurcation": "v", "unconverged": "D", "target_reached": "|",
+               "contact": "x"}  # where a curve ends, by reason (contact: a path without contact forces)
+
+
 def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: float, path: Path) -> Path:
     """Torque-rotation curves of the large-deflection paths: the Pareto candidates (the ranked pool when it
-    could not be scored) in colour, the other solved ones in grey; each curve's stop marked by its reason
-    (x: contact), first contact where the path goes on through it (x), where the tensile strain passes the cyclic (o) and the single-event limit (s), and the load
-    torques. The legend names at
+    could not be scored) in colour, the other solved ones in grey; each curve's end marked by its reason
+    (`END_MARKERS`), first contact (x), where the tensile strain passes the cyclic (o) and the single-event limit
+    (s), and the load torques. The legend names at
     most LEGEND_CURVES of the coloured curves: the chosen one, then the lightest."""
     fig, ax = plt.subplots(figsize=(7, 6.2))
     solved = t[t["status"] == "ok"]
@@ -124,7 +128,6 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
     shown = solved[pareto] if pareto.any() else solved[solved["rank"].notna()]
     for _, r in solved.drop(index=shown.index).iterrows():
         ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color="0.8", lw=0.8)
-    markers = {"contact": "x", "limit_point": "^", "bifurcation": "v", "target_reached": "|"}  # where it ends
     shown = shown.assign(_chosen=shown.index == chosen).sort_values(["_chosen", "mass_g"], ascending=[False, True],
                                                                     kind="stable")
     for i, (_, r) in enumerate(shown.iterrows()):
@@ -133,9 +136,9 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
         ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color=color, lw=1.6 if named else 0.8,
                 label=f"{r['candidate']} ({r['large_stop_reason']})" if named else None,
                 zorder=3 if r["_chosen"] else 2)
-        ax.plot(r["large_stop_rotation_rad"], r["large_stop_torque_Nm"], markers.get(r["large_stop_reason"], "s"),
+        ax.plot(r["large_stop_rotation_rad"], r["large_stop_torque_Nm"], END_MARKERS.get(r["large_stop_reason"], "*"),
                 color=color, ms=9, mew=2)
-        if r["large_stop_reason"] != "contact" and np.isfinite(r["large_contact_rotation_rad"]):  # through contact
+        if np.isfinite(r["large_contact_rotation_rad"]):  # first contact (a schema-2 row's stop at contact: the same)
             ax.plot(r["large_contact_rotation_rad"], r["large_contact_torque_Nm"], "x", color=color, ms=9, mew=2)
         for kind, marker in (("cyclic", "o"), ("single", "s")):
             if np.isfinite(r[f"large_{kind}_limit_rotation_rad"]):
@@ -145,7 +148,8 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
         ax.axhline(torque, color="k", ls="--", lw=0.8)
         ax.annotate(f"{name} {torque:.3g} Nm", (0, torque), fontsize=7, xytext=(2, 2), textcoords="offset points")
     ax.set(xlabel="hub rotation (rad)", ylabel="torque (Nm)",
-           title="Large-deflection torque curves (x: contact; strain limit passed: o cyclic, s single-event)")
+           title="Large-deflection torque curves\n(x first contact; end: ^ limit point, v bifurcation, D unconverged; "
+                 "strain limit passed: o cyclic, s single-event)")
     ax.grid(alpha=0.3)
     more = len(shown) - LEGEND_CURVES
     ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.12),

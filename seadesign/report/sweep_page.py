@@ -112,8 +112,8 @@ def calibration_text(baseline: Baseline, t: pd.DataFrame, choice: Choice) -> str
 
 
 def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: dict[str, Path],
-               renders: dict[str, Path], baseline: Baseline | None = None, handoff: str | None = None) -> Page:
-    """The sweep's report; `handoff`: what spring.json hands on when it is not the ranked path (a section)."""
+               renders: dict[str, Path], baseline: Baseline | None = None) -> Page:
+    """The sweep's report."""
     if choice.index is None:
         headline, feasible = "No candidate was solved, so none can be chosen.", False
     else:
@@ -136,7 +136,7 @@ def sweep_page(study, t: pd.DataFrame, choice: Choice, settings: dict, figures: 
         table_caption=f"Ranked candidates (the first {len(ranked)})",
         figures=figures, renders=renders,
         sections=([("Calibration", calibration_text(baseline, t, choice))] if baseline is not None else [])
-                 + ([("Handoff", f"spring.json: {handoff}.")] if handoff is not None else []) + [
+                 + [
                   ("Study", study_text(study)), ("Objectives", objectives_text(study)), ("Linear model", LINEAR_NOTE),
                   ("Input files", study.files.describe())],
         details=[("All candidates (full table)", summary_table(t)),

@@ -16,7 +16,7 @@ from seadesign.report.sweep_page import Baseline, sweep_page
 from seadesign.run.atomic import atomic_write
 from seadesign.run.cache import Cache, digest
 from seadesign.run.fingerprint import code_fingerprint
-from seadesign.sweep.handoff import through_contact_note, write_handoff
+from seadesign.sweep.handoff import write_handoff
 from seadesign.sweep.path_stage import PathResponse, path_key
 from seadesign.sweep.rank import Choice
 from seadesign.sweep.stages import SolverSettings, geometry_key
@@ -53,10 +53,8 @@ def chosen_path(study: Study, row: pd.Series, solver: SolverSettings, cache: Cac
 
 def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, settings: dict, *,
                   solver: SolverSettings, cache: Cache, export_all: bool = False,
-                  tolerance_mm: float = 0.01, baseline: Baseline | None = None,
-                  handed: pd.Series | None = None) -> dict[str, list[Path]]:
-    """Write every output of a ranked sweep (a calibrated one compared with its `baseline`); returns paths by kind.
-    `handed`: the chosen row as spring.json hands it on, when not as ranked (`handoff.through_contact_row`)."""
+                  tolerance_mm: float = 0.01, baseline: Baseline | None = None) -> dict[str, list[Path]]:
+    """Write every output of a ranked sweep (a calibrated one compared with its `baseline`); returns paths by kind."""
     folder.mkdir(parents=True, exist_ok=True)
     written: dict[str, list[Path]] = {"tables": write_tables(t, settings, folder)}
     figures = write_plots(study, t, choice, folder)
@@ -71,13 +69,9 @@ def write_outputs(study: Study, t: pd.DataFrame, choice: Choice, folder: Path, s
                      "failed_constraints": str(row["failed_constraints"]), "not_judged": str(row["not_judged"]),
                      "deciding_objective": study.requirements.objectives[0], "rank": int(row["rank"]),
                      "explanation": choice.explanation}
-        if handed is not None:
-            selection["curve"] = (through_contact_note(handed) + "; the requirements were judged on the path without "
-                                  "contact forces, which stops where the gap closes")
-        written["spring"] = [write_handoff(study, t, row if handed is None else handed, folder, settings, selection)]
+        written["spring"] = [write_handoff(study, t, row, folder, settings, selection)]
     written["cad"] = export_cad(study, cad_rows, folder, tolerance_mm, cache)
     written["images"] = [*figures.values(), *renders.values()]
-    page = sweep_page(study, t, choice, settings, figures, renders, baseline,
-                      None if handed is None else selection["curve"])
+    page = sweep_page(study, t, choice, settings, figures, renders, baseline)
     written["report"] = [write_markdown(folder / "report.md", page), write_html(folder / "report.html", page)]
     return written

@@ -4,7 +4,7 @@ The path (`fea.rotation_path`, the material's hyperelastic law) runs from rest t
 torque or to where it stops, on the result mesh's in-plane sizing with `SolverSettings.path_layers`
 layers through the thickness (its error against the result mesh is in docs/validation/mesh-convergence.md). `fea.large_deflection`
 reads it at the standing, stall and impact torques. The result is cached under the mesh, the law,
-the path settings, the torques, the strain limits, the end-stop rule and the code.
+the path settings, the torques, the strain limits and the code.
 
 A material calibrated by a stiffness scale s (`Material.scaled`) has the path of the material it was scaled
 from driven to the loads over s, its torques times s (`fea.path_scale`): read from that material's path when the
@@ -51,19 +51,17 @@ class PathResponse:
     path: TorquePath  # the path's points, stop and events, without its states (what a scaled law reads again)
 
 
-def path_settings(study: Study) -> PathSettings:
-    """The path's settings: with the study's `[ranking] self_contact`, through frictionless self-contact."""
-    return through_contact(PathSettings()) if study.ranking.self_contact else PathSettings()
+PATH_SETTINGS = through_contact(PathSettings())  # the sweep's path goes on through frictionless self-contact
 
 
 def path_key(study: Study, candidate: Candidate, settings: SolverSettings) -> str:
-    """Inputs of the path: the mesh, the law, the path's mesh and settings, the torques, the strain limits,
-    the end-stop rule and the code of this module with everything it imports."""
+    """Inputs of the path: the mesh, the law, the path's mesh and settings, the torques, the strain limits
+    and the code of this module with everything it imports."""
     lc = study.load_cases
     return digest("path", mesh_key(study, candidate), candidate.material.law, settings.path_layers,
-                  settings.path_formulation, path_settings(study), study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm,
+                  settings.path_formulation, PATH_SETTINGS, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm,
                   lc.impact_torque_Nm, candidate.material.strain_limits(study.ranking.safety_factor),
-                  study.ranking.contact_is_end_stop, code_fingerprint(__name__), package_versions())
+                  code_fingerprint(__name__), package_versions())
 
 
 def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], settings: SolverSettings, cache: Cache,
@@ -77,7 +75,7 @@ def path_response(study: Study, candidate: Candidate, part: Callable[[], Part], 
     scale = None if base.scaled_from is None else base.law.scale_of(base.scaled_from.law)
     if scale is not None:
         base, s = base.scaled_from, scale
-    lc, gap = study.load_cases, path_settings(study).contact_gap_mm
+    lc, gap = study.load_cases, PATH_SETTINGS.contact_gap_mm
     unscaled = None if s == 1.0 else cache.get("path", path_key(study, replace(candidate, material=base), settings))
     path = None if unscaled is None else scaled_path(unscaled.path, s, lc.impact_torque_Nm, gap, lc.stall_torque_Nm)
     if path is not None:  # the uncalibrated path's points are this one's
@@ -93,8 +91,7 @@ def _read(study: Study, candidate: Candidate, path: TorquePath) -> LargeDeflecti
     """The path read at the study's loads."""
     lc = study.load_cases
     return large_deflection(path, study.robot.standing_knee_torque_Nm, lc.stall_torque_Nm, lc.impact_torque_Nm,
-                            candidate.material.strain_limits(study.ranking.safety_factor),
-                            study.ranking.contact_is_end_stop)
+                            candidate.material.strain_limits(study.ranking.safety_factor))
 
 
 def _solved_response(study: Study, candidate: Candidate, law: Hyperelastic, s: float, part: Callable[[], Part],
@@ -104,10 +101,10 @@ def _solved_response(study: Study, candidate: Candidate, law: Hyperelastic, s: f
     mesh = tetrahedralize(study, candidate, part(), cache, layers=settings.path_layers)
     progress("path")
     lc = study.load_cases
-    path = rotation_path(mesh, law, lc.impact_torque_Nm / s, path_settings(study), order=settings.element_order,
+    path = rotation_path(mesh, law, lc.impact_torque_Nm / s, PATH_SETTINGS, order=settings.element_order,
                          formulation=settings.path_formulation, snapshot_torque_Nm=lc.stall_torque_Nm / s)
     if s != 1.0:  # serves by construction: driven to the loads over s
-        path = scaled_path(path, s, lc.impact_torque_Nm, path_settings(study).contact_gap_mm, lc.stall_torque_Nm)
+        path = scaled_path(path, s, lc.impact_torque_Nm, PATH_SETTINGS.contact_gap_mm, lc.stall_torque_Nm)
     result = _read(study, candidate, path)
     tensile = Solid.of(path.emesh, law, settings.path_formulation).element_strain_stress(
         path.snapshot_displacement_m).tensile_strain

@@ -9,7 +9,6 @@ otherwise SI (N, Nm, rad, Pa).
 from __future__ import annotations
 
 import json
-import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -18,7 +17,6 @@ from seadesign.design.materials import Hyperelastic
 from seadesign.design.study import DEFAULT_STUDY, Study, load_study
 from seadesign.errors import ConfigError
 from seadesign.run.cache import default_cache
-from seadesign.sweep.handoff import through_contact_note, through_contact_row
 from seadesign.sweep.rank import Choice, rank
 from seadesign.sweep.runner import SweepRun, run_sweep, sweep_settings
 from seadesign.sweep.stages import SolverSettings
@@ -148,9 +146,6 @@ class SweepResult:
         The files written, by kind (tables, plots, report, cad, spring).
     comparison : str or None
         With a calibration: the choice with and without it, and whether each carries the standing load.
-    handoff_note : str or None
-        With `handoff_through_contact`, where the ranking's path of the choice stopped at contact: spring.json's
-        curve through self-contact, its first contact and its end.
     """
 
     study: Study
@@ -160,7 +155,6 @@ class SweepResult:
     folder: Path
     written: dict[str, list[Path]]
     comparison: str | None = None
-    handoff_note: str | None = None
 
     def lines(self, quiet: bool = False) -> list[str]:
         """What `seadesign sweep` prints when it is done.
@@ -192,8 +186,6 @@ class SweepResult:
             out += [f"wrote {p}" for paths in self.written.values() for p in paths]
         if "spring" in self.written:
             out.append(f"{self.written['spring'][0]}: {handoff_verdict(self.ranked, self.choice)}")
-        if self.handoff_note is not None:
-            out.append(f"spring.json: {self.handoff_note}")
         return out
 
     def to_frame(self) -> pd.DataFrame:
@@ -255,8 +247,7 @@ class SweepResult:
 def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, baseline: Study | None = None,
                 jobs: int | None = None, quiet: bool = False, executor: str = "local", scheduler: str | None = None,
                 export_all: bool = False, cache_dir: str | Path | None = None,
-                tolerance_mm: float = 0.01, calibration_note: str | None = None,
-                handoff_through_contact: bool = False) -> SweepResult:
+                tolerance_mm: float = 0.01, calibration_note: str | None = None) -> SweepResult:
     """Sweep a loaded study (see `sweep_study`); with `baseline`, `study` is its calibrated form, written to
     ``OUT/<study>-calibrated/``, and the baseline is swept too for the comparison.
 
@@ -268,7 +259,7 @@ def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, base
         Output root; files go to ``out_dir/<study>/``.
     baseline : Study, optional
         The uncalibrated study `study` was calibrated from (`apply_calibration`).
-    jobs, quiet, executor, scheduler, export_all, cache_dir, tolerance_mm, handoff_through_contact
+    jobs, quiet, executor, scheduler, export_all, cache_dir, tolerance_mm
         As in `sweep_study`.
     calibration_note : str, optional
         What the calibration changed (`apply_calibration`'s note), said in the report's Calibration section.
@@ -303,24 +294,15 @@ def sweep_and_write(study: Study, out_dir: str | Path = Path("exports"), *, base
         base_ranked, base_choice = rank(run_sweep(baseline, out_dir / baseline.name, **options).rows, baseline)
         comparison = calibration_summary(base_ranked, base_choice, ranked, choice, study)
         compared = Baseline(calibration_note or "the calibration file's material", base_ranked, base_choice)
-    handed = None
-    if (handoff_through_contact and choice.index is not None and not study.ranking.self_contact
-            and ranked.loc[choice.index, "large_stop_reason"] == "contact"):
-        if not quiet:
-            print("spring.json: the chosen design's path through self-contact (one path; 10-20 minutes on 2 cores)",
-                  file=sys.stderr, flush=True)
-        handed = through_contact_row(study, ranked.loc[choice.index], solver, cache)
     written = write_outputs(study, ranked, choice, folder, sweep_settings(study, solver), solver=solver, cache=cache,
-                            export_all=export_all, tolerance_mm=tolerance_mm, baseline=compared, handed=handed)
-    return SweepResult(study, ranked, choice, run, folder, written, comparison,
-                       None if handed is None else through_contact_note(handed))
+                            export_all=export_all, tolerance_mm=tolerance_mm, baseline=compared)
+    return SweepResult(study, ranked, choice, run, folder, written, comparison)
 
 
 def sweep_study(study: str | Path | Study = DEFAULT_STUDY.stem, out_dir: str | Path = Path("exports"), *,
           calibration: str | Path | None = None, jobs: int | None = None, quiet: bool = False,
           executor: str = "local", scheduler: str | None = None, export_all: bool = False,
-          cache_dir: str | Path | None = None, tolerance_mm: float = 0.01,
-          handoff_through_contact: bool = False) -> SweepResult:
+          cache_dir: str | Path | None = None, tolerance_mm: float = 0.01) -> SweepResult:
     """Run every candidate of a study (geometry, validity, mesh, both linear load cases, the large-deflection
     torque path), rank them on their paths and write the results, plots, report, STL/STEP and spring.json,
     as `seadesign sweep`. Resumable: stored rows and cached stages are reused.
@@ -348,10 +330,6 @@ def sweep_study(study: str | Path | Study = DEFAULT_STUDY.stem, out_dir: str | P
         Stage cache folder; None: $SEADESIGN_CACHE, else ~/.cache/seadesign.
     tolerance_mm : float
         STL chordal tolerance (mm).
-    handoff_through_contact : bool
-        Where the chosen design's path stops at contact (the study's paths without self-contact), hand on in
-        spring.json its curve through frictionless self-contact: one more path, on the same mesh (10-20 minutes
-        on 2 cores). The ranking and the requirements' verdicts stay those of the paths without contact forces.
 
     Returns
     -------
@@ -378,6 +356,5 @@ def sweep_study(study: str | Path | Study = DEFAULT_STUDY.stem, out_dir: str | P
         study, note = apply_calibration(study, calibration)
     return sweep_and_write(study, out_dir, baseline=baseline, jobs=jobs, quiet=quiet, executor=executor,
                            scheduler=scheduler, export_all=export_all, cache_dir=cache_dir, tolerance_mm=tolerance_mm,
-                           calibration_note=note if baseline is not None else None,
-                           handoff_through_contact=handoff_through_contact)
+                           calibration_note=note if baseline is not None else None)
 

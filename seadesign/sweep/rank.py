@@ -156,15 +156,13 @@ def unblock(row: pd.Series, study: Study) -> str:
     hints = []
     if any(row.get(f"{load}_travel_margin", 0.0) < 0 for load in study.requirements.loads):
         reason, cause = row["large_stop_reason"], row.get("large_unconverged_cause", "")
-        if reason == "contact":
-            hints.append("its path ends in contact before a load: contact carrying the load past the closing gap (the "
-                         "study's [ranking] self_contact = true) or a larger envelope")
-        elif isinstance(cause, str) and cause:  # a row from an older table has none (or NaN)
+        if isinstance(cause, str) and cause:  # a row from an older table has none (or NaN)
             hints.append(f"its path ends unconverged in contact before a load ({cause.replace('_', ' ')} at "
                          f"{row['large_unconverged_rotation_rad']:.4g} rad, at x {row['large_unconverged_at_x_mm']:.1f}, "
                          f"y {row['large_unconverged_at_y_mm']:.1f} mm): a stiffer material or a larger envelope")
         else:
-            hints.append(f"its path ends in {reason} before a load: a stiffer material or a larger envelope")
+            ends = "unconverged" if reason == "unconverged" else f"in a {reason.replace('_', ' ')}"
+            hints.append(f"its path ends {ends} before a load: a stiffer material or a larger envelope")
     if row.get("torque_resolution_margin", 0.0) < 0 or row.get("k_max_margin", 0.0) < 0:
         hints.append("a softer spring (thinner or fewer beams, a softer material)")
     if any(row.get(c, 0.0) < 0 for c in ("standing_margin", "natural_frequency_margin", "k_min_margin",

@@ -104,12 +104,10 @@ def limit_torque(t: pd.DataFrame, kind: str) -> pd.Series:
     return _col(t, f"large_{kind}_limit_torque_Nm") * STRAIN_TORQUE_KNOCKDOWN
 
 
-def _load_margins(t: pd.DataFrame, load: str, torque_Nm: float, end_stop: bool) -> tuple[pd.Series, pd.Series]:
+def _load_margins(t: pd.DataFrame, load: str, torque_Nm: float) -> tuple[pd.Series, pd.Series]:
     """(travel, strain) margins at one load, the strain against the load class's limit."""
-    travel_end = _col(t, "large_stop_torque_Nm")
-    carried = _col(t, f"large_{load}_rotation_rad").notna()  # reached, or held by contact as the end stop
-    at_end_stop = carried & (travel_end < torque_Nm) if end_stop else pd.Series(False, index=t.index)
-    travel = (travel_end / torque_Nm - 1.0).where(~at_end_stop, 0.0)
+    travel = _col(t, "large_stop_torque_Nm") / torque_Nm - 1.0
+    carried = _col(t, f"large_{load}_rotation_rad").notna()
     crossing = limit_torque(t, LOAD_CLASS[load][0])
     strain = (crossing / torque_Nm - 1.0).where(crossing.notna())
     never = crossing.isna() & carried  # limit / strain - 1 (NaN: no sourced limit)
@@ -159,7 +157,7 @@ def margins(t: pd.DataFrame, study: Study) -> pd.DataFrame:
     torques = {"stall": lc.stall_torque_Nm, "impact": lc.impact_torque_Nm}
     strain = {}
     for load in req.loads:
-        out[f"{load}_travel_margin"], strain[load] = _load_margins(t, load, torques[load], study.ranking.contact_is_end_stop)
+        out[f"{load}_travel_margin"], strain[load] = _load_margins(t, load, torques[load])
     for load in req.loads:
         out[f"{load}_strain_margin"] = strain[load]
     travel = _col(t, "large_stop_torque_Nm")
