@@ -7,7 +7,7 @@ its workers, resident set), the resident sets summed over the command and all it
 pages of shared libraries once per process), and their proportional set sizes summed (each shared page split among
 the processes that map it: the memory the run takes from the machine).
 
-Usage: python benchmarks/sweep.py [STUDY] [--jobs N]
+Usage: python benchmarks/sweep.py [STUDY] [--jobs N] [--keep DIR]
 """
 
 from __future__ import annotations
@@ -64,9 +64,14 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("study", nargs="?", default="wolfgang_knee")
     ap.add_argument("--jobs", type=int, default=len(os.sched_getaffinity(0)), help="worker processes (count)")
+    ap.add_argument("--keep", type=Path, default=None, help="an empty or new directory that keeps the outputs "
+                    "(exports/) and the stage cache (cache/); default: a temporary one, removed")
     args = ap.parse_args()
+    if args.keep is not None and args.keep.exists() and any(args.keep.iterdir()):
+        raise SystemExit(f"--keep {args.keep} is not empty: a cold run needs an empty cache; give a new directory")
     with tempfile.TemporaryDirectory(prefix="seadesign-bench-") as d:
-        out, cache = Path(d) / "exports", Path(d) / "cache"
+        root = Path(d) if args.keep is None else args.keep
+        out, cache = root / "exports", root / "cache"
         cold = timed_sweep(args.study, args.jobs, out, cache)
         warm = timed_sweep(args.study, args.jobs, out, cache)
     print(f"machine: {machine()}")

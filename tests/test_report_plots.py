@@ -34,6 +34,27 @@ def test_torque_curve_legend_names_the_choice_then_the_lightest(tmp_path, monkey
     assert [(tuple(c.get_xdata()), tuple(c.get_ydata())) for c in crosses] == [((0.05,), (10.0,))]  # first contact
 
 
+def test_the_choice_is_drawn_in_colour_off_the_front_and_an_unconverged_end_has_its_own_marker(tmp_path, monkeypatch):
+    """A nearest design that is not on the Pareto front (nothing feasible) is still the red, named curve; its end
+    (unconverged in a crease) is a diamond, the grey curves carry no markers."""
+    t = pd.DataFrame({"candidate": ["front", "choice", "other"], "status": "ok", "pareto": [True, False, False],
+                      "mass_g": [20.0, 30.0, 25.0], "large_curve_rotation_rad": [[0.0, 0.3]] * 3,
+                      "large_curve_torque_Nm": [[0.0, 5.0], [0.0, 10.0], [0.0, 4.0]],
+                      "large_stop_reason": ["bifurcation", "unconverged", "unconverged"],
+                      "large_stop_rotation_rad": 0.3, "large_stop_torque_Nm": [5.0, 10.0, 4.0],
+                      **{f"large_{kind}_limit_{x}": np.nan for kind in ("cyclic", "single")
+                         for x in ("rotation_rad", "torque_Nm")},
+                      "large_contact_rotation_rad": [np.nan, 0.2, 0.2], "large_contact_torque_Nm": [np.nan, 7.0, 3.0]})
+    figures = []
+    monkeypatch.setattr(plots.plt, "close", figures.append)
+    plots.fig_curves(t, 1, 11.7, 27.7, tmp_path / "curves.png")
+    ax = figures[0].axes[0]
+    assert [text.get_text() for text in ax.get_legend().get_texts()] == ["choice (unconverged)", "front (bifurcation)"]
+    ends = {(line.get_marker(), line.get_color(), float(line.get_ydata()[0])) for line in ax.get_lines()
+            if line.get_marker() in ("D", "v")}
+    assert ends == {("D", "r", 10.0), ("v", plots._NOT_RED[1], 5.0)}
+
+
 def test_parallel_coordinates_draw_a_categorical_axis_as_its_categories(tmp_path, monkeypatch):
     """The material axis (strings) is drawn as its categories: each design's line passes through its own
     material's tick, and the ticks are named (it was drawn as "nan-nan" with no line through it)."""

@@ -117,15 +117,15 @@ END_MARKERS = {"limit_point": "^", "bifurcation": "v", "unconverged": "D", "targ
 
 
 def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: float, path: Path) -> Path:
-    """Torque-rotation curves of the large-deflection paths: the Pareto candidates (the ranked pool when it
-    could not be scored) in colour, the other solved ones in grey; each curve's end marked by its reason
-    (`END_MARKERS`), first contact (x), where the tensile strain passes the cyclic (o) and the single-event limit
-    (s), and the load torques. The legend names at
-    most LEGEND_CURVES of the coloured curves: the chosen one, then the lightest."""
+    """Torque-rotation curves of the large-deflection paths: the Pareto candidates and the chosen one (the ranked
+    pool when it could not be scored) in colour, the other solved ones in grey; each curve's end marked by its
+    reason (`END_MARKERS`), first contact (x), where the tensile strain passes the cyclic (o) and the single-event
+    limit (s), and the load torques. The legend names at most LEGEND_CURVES of the coloured curves: the chosen one,
+    then the lightest."""
     fig, ax = plt.subplots(figsize=(7, 6.2))
     solved = t[t["status"] == "ok"]
     pareto = solved["pareto"].astype(bool)
-    shown = solved[pareto] if pareto.any() else solved[solved["rank"].notna()]
+    shown = solved[pareto | (solved.index == chosen)] if pareto.any() else solved[solved["rank"].notna()]
     for _, r in solved.drop(index=shown.index).iterrows():
         ax.plot(r["large_curve_rotation_rad"], r["large_curve_torque_Nm"], "-", color="0.8", lw=0.8)
     shown = shown.assign(_chosen=shown.index == chosen).sort_values(["_chosen", "mass_g"], ascending=[False, True],
@@ -147,9 +147,9 @@ def fig_curves(t: pd.DataFrame, chosen: int | None, stall_Nm: float, impact_Nm: 
     for torque, name in ((stall_Nm, "stall"), (impact_Nm, "impact")):
         ax.axhline(torque, color="k", ls="--", lw=0.8)
         ax.annotate(f"{name} {torque:.3g} Nm", (0, torque), fontsize=7, xytext=(2, 2), textcoords="offset points")
-    ax.set(xlabel="hub rotation (rad)", ylabel="torque (Nm)",
-           title="Large-deflection torque curves\n(x first contact; end: ^ limit point, v bifurcation, D unconverged; "
-                 "strain limit passed: o cyclic, s single-event)")
+    ax.set(xlabel="hub rotation (rad)", ylabel="torque (Nm)")
+    ax.set_title("Large-deflection torque curves\nx first contact; end: ^ limit point, v bifurcation, D unconverged; "
+                 "strain limit passed: o cyclic, s single-event", fontsize=8)
     ax.grid(alpha=0.3)
     more = len(shown) - LEGEND_CURVES
     ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.12),
