@@ -122,8 +122,9 @@ def test_unloading_retraces_loading(candidate):
 @pytest.mark.parametrize("failure", ["contact_energy_loss", "contact_unconverged"])
 def test_an_increment_that_fails_at_every_step_ends_the_path_saying_where(candidate, monkeypatch, failure):
     # past 0.35 rad every attempt made to fail (as where a fold loses energy, or Newton wanders in a crease, at every
-    # step size): the increments past it are cut back to the smallest step, none is kept, and the path ends
-    # unconverged with the event there
+    # step size): the increments past it are cut back to the smallest step from a point in contact (first contact
+    # is at 0.318 rad), none is kept, and the path ends unconverged with the event there, the last attempt's step
+    # between that smallest step and twice it (not `min_step_rad`, which holds only before contact)
     import seadesign.fea.rotation_path as rp
 
     if failure == "contact_energy_loss":
@@ -135,9 +136,12 @@ def test_an_increment_that_fails_at_every_step_ends_the_path_saying_where(candid
         monkeypatch.setattr(rp, "_solve", lambda p, u, v, previous, last, step, theta, *held: (
             lambda r: r if theta <= 0.35 else replace(r, status="failed"))(solve(p, u, v, previous, last, step, theta,
                                                                                  *held)))
-    path = _path(candidate, min_step_rad=0.002)
+    floor = 0.004
+    path = _path(candidate, contact_min_step_rad=floor)
     assert path.stop_reason == "unconverged" and path.points[-1].rotation_rad <= 0.35
-    assert path.points[-1].rotation_rad > 0.35 - 0.004  # cut back until the step is below the smallest
+    assert path.points[-1].rotation_rad > 0.35 - 2 * floor  # cut back until the step is below the smallest
+    assert path.points[-1].contact.area_m2 > 0
     event = path.events[-1]
-    assert event.kind == failure and 0.35 < event.rotation_rad < 0.35 + 0.004
+    assert event.kind == failure and 0.35 < event.rotation_rad < 0.35 + 2 * floor
+    assert floor <= event.rotation_rad - path.points[-1].rotation_rad < 2 * floor
     assert math.isnan(event.torque_Nm) and np.isfinite(event.at_mm).all()
