@@ -46,7 +46,8 @@ def validate_spring(data: Any, source: str = "spring.json") -> dict[str, Any]:
             if err.validator == "required":  # name the missing key itself
                 path.append(err.message.split("'")[1])
             field = "/".join(path) or "(top level)"
-            why = f"{err.instance!r} is not allowed: {err.schema['description']}" if err.validator == "not" else err.message
+            why = (f"{err.instance!r} is not allowed: {err.schema['description']}" if err.validator == "not"
+                   else err.message)
             lines.append(f"  field '{field}': {why}")
         raise SpringFileError(
             f"{source} does not match the spring.json schema (seadesign/design/schemas/spring.schema.json):\n"
