@@ -54,7 +54,9 @@ def _work(path) -> float:
 def test_the_path_goes_on_through_contact(through):
     assert through.stop_reason == "rotation_limit" and through.stop_rotation_rad == END_RAD
     (event,) = through.events
-    assert event.kind == "contact" and 0.31 < event.rotation_rad < 0.32  # measured 0.3179 rad (the step landed at 0.32)
+    # measured 0.3020 rad, where a Gauss point beside the notch's root presses on the face across the root (its
+    # vertices are still 0.11 mm apart); the event is only as precise as the step that reaches it (0.295-0.305 rad)
+    assert event.kind == "contact" and 0.29 < event.rotation_rad < 0.31
     last = through.points[-1].contact
     assert last.area_m2 > 1e-6 and last.peak_pressure_Pa > 1e6 and last.moment_Nm > 0.05  # measured 1.9 mm^2, 13 MPa, 0.24 Nm
     tolerance_m = ContactSettings().penetration_tol_mm * 1e-3
@@ -73,19 +75,32 @@ def test_frictionless_contact_stores_no_energy(candidate, through):
 
 
 def test_before_contact_the_path_is_the_one_without_contact_forces(candidate, through):
-    # the path that stops at contact solves the same equilibria until then: its points lie on the through-contact
-    # curve to the Hermite interpolation's error (measured 1.8e-5)
+    # the path that stops where the vertices come within 0.1 mm solves the same equilibria until the first contact:
+    # its points lie on the through-contact curve to the Hermite interpolation's error (measured 1.8e-5) where that
+    # curve's interpolation does not reach across the contact's onset
     stop = _path(candidate, contact=None)
     assert stop.stop_reason == "contact"
-    for point in stop.points[1:]:
+    free = max(p.rotation_rad for p in through.points if p.contact.area_m2 == 0)
+    before = [p for p in stop.points[1:] if p.rotation_rad <= free]
+    assert len(before) >= 7
+    for point in before:
         assert through.torque_at(point.rotation_rad) == pytest.approx(point.torque_Nm, rel=1e-4)
 
 
 @pytest.mark.slow
-def test_the_torque_does_not_depend_on_the_penalty(candidate, through):
-    # a ten times tighter penetration tolerance moves the end torque by 4.5e-6 (measured)
+@pytest.mark.parametrize("penalty_factor", [30.0, 300.0])
+def test_the_torque_does_not_depend_on_the_penalty(candidate, through, penalty_factor):
+    # a penalty 3.3 times softer or 3 times stiffer moves the end torque by 1.7e-5 and 2.3e-5 (measured)
+    other = _path(candidate, contact=ContactSettings(penalty_factor=penalty_factor))
+    assert other.points[-1].torque_Nm == pytest.approx(through.points[-1].torque_Nm, rel=1e-4)
+
+
+@pytest.mark.slow
+def test_the_torque_converges_with_the_penetration_tolerance(candidate, through):
+    # a nine times tighter tolerance moves the end torque by 1.6e-4 (measured; 4.5e-6 before the pairs across a
+    # notch's root were searched: those points start within 26 um of the face across, so 4.5 um is a larger share)
     tight = _path(candidate, contact=ContactSettings(penetration_tol_mm=0.0005))
-    assert tight.points[-1].torque_Nm == pytest.approx(through.points[-1].torque_Nm, rel=1e-4)
+    assert tight.points[-1].torque_Nm == pytest.approx(through.points[-1].torque_Nm, rel=4e-4)
 
 
 @pytest.mark.slow
@@ -145,3 +160,45 @@ def test_an_increment_that_fails_at_every_step_ends_the_path_saying_where(candid
     assert event.kind == failure and 0.35 < event.rotation_rad < 0.35 + 2 * floor
     assert floor <= event.rotation_rad - path.points[-1].rotation_rad < 2 * floor
     assert math.isnan(event.torque_Nm) and np.isfinite(event.at_mm).all()
+
+
+def test_no_surface_point_sinks_into_a_face_it_faces(candidate, through):
+    # brute force, apart from the contact search: every Gauss point of the boundary's faces against every flat facet
+    # of a later face (the contact's one pass, `ContactSurface`) that it faces (normals opposed, the point in front of
+    # it at rest) and projects inside at the end; none may lie deeper behind the facet's plane than the penetration
+    # tolerance (within the search's 0.1 mm: deeper points entered from the side at a fold). Measured 4.3 um
+    # (the tolerance 4.5 um); before the pairs across a notch's root were searched, points beside the roots sank up to 10 um
+    # into the face across
+    from scipy.spatial import cKDTree
+    from seadesign.fea.contact import FACING_COSINE, ContactSurface
+    from seadesign.fea.contact_geometry import FACE_WEIGHTS, SUBFACETS
+    mesh, _ = candidate
+    emesh, u = through.emesh, through.displacement_m
+    surface = ContactSurface.of(emesh, mesh.boundary_faces, np.empty(0, dtype=np.int64))
+    x, x0 = surface.nodes_m + u, surface.nodes_m
+    points, rest = surface.points(u), surface.rest_points_m
+    tri, tri0 = x[surface.facets], x0[surface.facets]
+
+    def normals(t):
+        n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        return n / np.linalg.norm(n, axis=1)[:, None]
+
+    n, n0 = normals(tri), normals(tri0)
+    corners = x[surface.faces[:, :3]]
+    n_face = normals(corners)
+    centroid = tri.mean(axis=1)
+    reach = np.linalg.norm(tri - centroid[:, None], axis=2).max() + 1e-4
+    deepest = 0.0
+    for f, near in enumerate(cKDTree(points).query_ball_point(centroid, reach)):
+        q = np.array(near, dtype=np.int64)
+        q = q[q // len(FACE_WEIGHTS) < f // len(SUBFACETS)]  # one pass: a face's points against later faces' facets
+        q = q[(n_face[q // len(FACE_WEIGHTS)] @ n[f] < FACING_COSINE) & ((rest[q] - tri0[f, 0]) @ n0[f] > 0)]
+        gap = (points[q] - tri[f, 0]) @ n[f]
+        e1, e2, d = tri[f, 1] - tri[f, 0], tri[f, 2] - tri[f, 0], points[q] - tri[f, 0] - gap[:, None] * n[f]
+        a11, a12, a22 = e1 @ e1, e1 @ e2, e2 @ e2
+        s, t = (a22 * (d @ e1) - a12 * (d @ e2)), (a11 * (d @ e2) - a12 * (d @ e1))
+        det = a11 * a22 - a12**2
+        inside = (s >= 0) & (t >= 0) & (s + t <= det)
+        sunk = -gap[inside & (gap > -1e-4)]
+        deepest = max(deepest, float(sunk.max(initial=0.0)))
+    assert deepest <= 1.5 * ContactSettings().penetration_tol_mm * 1e-3

@@ -190,9 +190,11 @@ class FrictionlessContact:
         from its facet's plane, extended past the facet's edges. Candidates, on the faces with a corner within
         `near_mm` of a vertex it faces: a point within a facet's reach (its largest centroid-to-corner distance plus
         `search_mm`) of its centroid and less than `search_mm` behind its plane, the point in front of the facet's
-        plane at rest, the point checked against the facet (see `ContactSurface`), the facet not touching the
-        point's face; of these, a point is paired with each facet it projects inside whose normal faces its face's
-        (`FACING_COSINE`)."""
+        plane at rest, the point checked against the facet (see `ContactSurface`: never its own face's); of these,
+        a point is paired with each facet it projects inside whose normal faces its face's (`FACING_COSINE`). A facet
+        whose face shares a node with the point's is paired too: where a notch's flanks meet at its root, leaving
+        those out let a point sink unseen into the other flank until it reached a facet without a shared node, which
+        then pressed it out with energy the hub never put in."""
         s = self.surface
         near = np.isin(s.faces[:, :3], self.vertices.facing_vertices(u, self.settings.near_mm * MM, NEAR_COSINE))
         near = near.any(axis=1)
@@ -212,7 +214,6 @@ class FrictionlessContact:
         f = facets[f]
         face, other = q // len(FACE_WEIGHTS), f // len(SUBFACETS)
         keep = s.checked[face] & (~s.checked[other] | (face < other))
-        keep &= ~(s.faces[face][:, :, None] == s.facets[f][:, None, :]).any(axis=(1, 2))
         q, f = q[keep], f[keep]
         x0 = s.nodes_m[s.facets[f]]
         n0 = np.cross(x0[:, 1] - x0[:, 0], x0[:, 2] - x0[:, 0])
