@@ -166,9 +166,9 @@ def test_no_surface_point_sinks_into_a_face_it_faces(candidate, through):
     # brute force, apart from the contact search: every Gauss point of the boundary's faces against every flat facet
     # of a later face (the contact's one pass, `ContactSurface`) that it faces (normals opposed, the point in front of
     # it at rest) and projects inside at the end; none may lie deeper behind the facet's plane than the penetration
-    # tolerance (within the search's 0.1 mm: deeper points entered from the side at a fold). Measured 4.3 um
-    # (the tolerance 4.5 um); before the pairs across a notch's root were searched, points beside the roots sank up to 10 um
-    # into the face across
+    # tolerance (within the search's 0.1 mm: deeper points entered from the side at a fold). Measured 4.3 um (the
+    # tolerance 4.5 um); before the pairs across a notch's root were searched, points beside the roots sank up to
+    # 10 um into the face across
     from scipy.spatial import cKDTree
     from seadesign.fea.contact import FACING_COSINE, ContactSurface
     from seadesign.fea.contact_geometry import FACE_WEIGHTS, SUBFACETS
