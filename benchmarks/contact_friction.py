@@ -1,8 +1,8 @@
 """What frictionless contact leaves out: CalculiX with a Coulomb friction coefficient against CalculiX frictionless,
 on the same mesh and contact pair, beside our (frictionless) path through contact.
 
-Usage: python benchmarks/contact_friction.py [--beams 3] [--thickness-mm 8] [--coarsening 4] [--max-rotation-rad 0.42]
-       [--friction 0.5] [--reach-mm 1.5] [--face-to-face]
+Usage: python benchmarks/contact_friction.py [--beams 3] [--thickness-mm 8] [--axial-thickness-mm 9] [--coarsening 4]
+       [--max-rotation-rad 0.42] [--friction 0.5] [--reach-mm 1.5] [--face-to-face]
 Our path through self-contact (`fea.rotation_path.through_contact`) on the candidate's one-layer path mesh, coarsened,
 to the impact torque or `--max-rotation-rad`; then CalculiX NLGEOM at the same rotations with a node-to-surface contact
 pair (our penalty; the slave the nodes of the faces within `--reach-mm` of where ours touches at the end, less those on
@@ -12,13 +12,16 @@ with the friction coefficient (stick slope the penalty's). `--face-to-face`: the
 where the pair's faces share the notch root's edge (see `fea.ccx_contact.ContactPairDeck`). Prints each rotation's
 torques and the frictional torque's difference, and the difference at the stall torque (where the frictionless
 CalculiX curve carries it; else at the last rotation both reached). TPU on TPU is far from frictionless, so this
-bounds the assumption on one candidate. The defaults are the candidate where both CalculiX runs converge (on 6 x 8 mm
-the node-to-surface pair crawls at first contact, 0.307 rad, frictionless).
+bounds the assumption on one candidate. `--axial-thickness-mm` replaces the study's axial thickness ([geometry]
+thickness_mm): the in-plane shape, and so where contact begins, stays, while the torque scales with it, so a thicker
+part carries the stall torque after first contact, where friction can act on it. The defaults are the candidate where
+both CalculiX runs converge (on 6 x 8 mm the node-to-surface pair crawls at first contact, 0.307 rad, frictionless).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import tempfile
 from pathlib import Path
 
@@ -41,6 +44,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--beams", type=int, default=3)
     ap.add_argument("--thickness-mm", type=float, default=8.0)
+    ap.add_argument("--axial-thickness-mm", type=float, default=None,
+                    help="replace the study's axial thickness (mm; default: the study's)")
     ap.add_argument("--coarsening", type=float, default=4.0)
     ap.add_argument("--max-rotation-rad", type=float, default=0.42)
     ap.add_argument("--friction", type=float, default=0.5)
@@ -49,6 +54,8 @@ def main() -> None:
                     help="face-to-face pair, ten times our penalty (with friction it does not converge)")
     args = ap.parse_args()
     study = load_study()
+    if args.axial_thickness_mm is not None:
+        study = dataclasses.replace(study, fixed={**study.fixed, "thickness_mm": args.axial_thickness_mm})
     lc, law = study.load_cases, study.material.law
     checked, part = study.check(study.candidate(beam_count=args.beams, beam_thickness_mm=args.thickness_mm))
     settings = through_contact(PathSettings(max_rotation_rad=args.max_rotation_rad))
@@ -84,7 +91,8 @@ def main() -> None:
                f"{theta[i]:.4f} rad ({where}; stall torque {lc.stall_torque_Nm:g} Nm). First contact at "
                f"{event.rotation_rad:.4f} rad, {event.torque_Nm:.3g} Nm; our path ends: {path.stop_reason} at "
                f"{path.stop_rotation_rad:.4f} rad, {path.stop_torque_Nm:.4g} Nm.")
-    settings_text = (f"{args.beams} beams x {args.thickness_mm:g} mm, path mesh {args.coarsening:g}x coarser "
+    settings_text = (f"{args.beams} beams x {args.thickness_mm:g} mm, {part.params.thickness_mm:g} mm thick, "
+                     f"path mesh {args.coarsening:g}x coarser "
                      f"({len(mesh.tets)} tetrahedra), to {args.max_rotation_rad:g} rad; "
                      f"{'node-to-surface' if node else 'face-to-face'} contact pair within "
                      f"{args.reach_mm:g} mm of where ours touches; CalculiX {free.wall_s:.0f} s "
