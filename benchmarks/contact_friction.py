@@ -10,8 +10,8 @@ the master faces; ccx's default residual tolerance, up to 30 iterations and 10 c
 with the friction coefficient (stick slope the penalty's). `--face-to-face`: the face-to-face pair of
 `fea.ccx.write_path_inp`'s check instead (ten times our penalty, residual 1e-7), which with friction does not converge
 where the pair's faces share the notch root's edge (see `fea.ccx_contact.ContactPairDeck`). Prints each rotation's
-torques and the frictional torque's difference, and the difference at the stall torque (where the frictionless
-CalculiX curve carries it; else at the last rotation both reached). TPU on TPU is far from frictionless, so this
+torques (ours also the part crossing contact) and the frictional torque's relative difference, and that difference
+at the stall torque (where the frictionless CalculiX curve carries it; else at the last rotation both reached). TPU on TPU is far from frictionless, so this
 bounds the assumption on one candidate. `--axial-thickness-mm` replaces the study's axial thickness ([geometry]
 thickness_mm): the in-plane shape, and so where contact begins, stays, while the torque scales with it, so a thicker
 part carries the stall torque after first contact, where friction can act on it. The defaults are the candidate where
@@ -78,17 +78,20 @@ def main() -> None:
             runs[mu] = run_ccx_path(inp, emesh.nodes_m, theta)
     free, rough = runs[0.0], runs[args.friction]
     n = min(len(free.torque_Nm), len(rough.torque_Nm))
-    table = Table(["rotation (rad)", "ours, frictionless (Nm)", "CalculiX, frictionless (Nm)",
-                   f"CalculiX, friction {args.friction:g} (Nm)", "friction's change"])
+    table = Table(["rotation (rad)", "ours, frictionless (Nm)", "ours, through contact (Nm)",
+                   "CalculiX, frictionless (Nm)", f"CalculiX, friction {args.friction:g} (Nm)", "friction's change"])
     for i in range(n):
-        table.add(f"{theta[i]:.4f}", f"{path.points[i + 1].torque_Nm:.4f}", f"{free.torque_Nm[i]:.4f}",
-                  f"{rough.torque_Nm[i]:.4f}", f"{rough.torque_Nm[i] / free.torque_Nm[i] - 1:+.3%}")
+        point = path.points[i + 1]
+        table.add(f"{theta[i]:.4f}", f"{point.torque_Nm:.4f}", f"{point.contact.moment_Nm:.4f}",
+                  f"{free.torque_Nm[i]:.4f}", f"{rough.torque_Nm[i]:.4f}",
+                  f"{rough.torque_Nm[i] / free.torque_Nm[i] - 1:+.1e}")
     event = path.events[0]
     at = np.flatnonzero(free.torque_Nm[:n] >= lc.stall_torque_Nm)
     i = int(at[0]) if len(at) else n - 1
     where = "the first rotation carrying the stall torque" if len(at) else "the last rotation both reached"
-    summary = (f"Friction {args.friction:g} changes the torque by {rough.torque_Nm[i] / free.torque_Nm[i] - 1:+.3%} at "
-               f"{theta[i]:.4f} rad ({where}; stall torque {lc.stall_torque_Nm:g} Nm). First contact at "
+    summary = (f"Friction {args.friction:g} changes the torque by {rough.torque_Nm[i] / free.torque_Nm[i] - 1:+.1e} "
+               f"(relative) at {theta[i]:.4f} rad ({where}; stall torque {lc.stall_torque_Nm:g} Nm), where contact "
+               f"carries {path.points[i + 1].contact.moment_Nm:.3g} Nm in our path. First contact at "
                f"{event.rotation_rad:.4f} rad, {event.torque_Nm:.3g} Nm; our path ends: {path.stop_reason} at "
                f"{path.stop_rotation_rad:.4f} rad, {path.stop_torque_Nm:.4g} Nm.")
     settings_text = (f"{args.beams} beams x {args.thickness_mm:g} mm, {part.params.thickness_mm:g} mm thick, "
