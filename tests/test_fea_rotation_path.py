@@ -93,3 +93,22 @@ def test_a_thin_plate_in_torsion_stops_where_the_tangent_loses_stability():
     at_rest, at_stop = smallest(np.zeros_like(path.displacement_m)), smallest(path.displacement_m)
     assert at_rest > 0 and 0 < at_stop < 0.05 * at_rest
     assert path.points[-1].tangent_Nm_per_rad > 0.9 * path.points[0].tangent_Nm_per_rad  # no torque maximum
+
+
+def test_a_path_has_the_same_digits_on_one_or_two_blas_threads():
+    # OpenBLAS sums a long dot product in an order set by its thread count; the path runs on one BLAS thread so that
+    # the machine's cores do not move its last digits (without it, 1 and 2 threads differ here by up to 1.8e-15 Nm)
+    from threadpoolctl import ThreadpoolController
+
+    openblas = ThreadpoolController().select(internal_api="openblas")
+    mesh = annulus_mesh(10.0, 20.0, H_MM, 6, 96, 2)  # 37,440 unknowns: long enough for OpenBLAS to split its sums
+    paths = []
+    for threads in (1, 2):
+        with openblas.limit(limits=threads):
+            if threads > 1 and max(i["num_threads"] for i in openblas.info()) < 2:
+                pytest.skip("OpenBLAS runs on one thread on this machine: nothing to compare")
+            paths.append(rotation_path(mesh, Hyperelastic.from_linear(E, 0.45), 1e9,
+                                       PathSettings(max_rotation_rad=0.3, max_step_rad=0.1)))
+    one, two = paths
+    assert [p.torque_Nm for p in one.points] == [p.torque_Nm for p in two.points]
+    assert np.array_equal(one.displacement_m, two.displacement_m)

@@ -44,6 +44,7 @@ import numpy as np
 
 from seadesign.design.materials import Hyperelastic
 from seadesign.errors import NotPositiveDefinite, SolverError
+from seadesign.fea.blas import one_blas_thread
 from seadesign.fea.contact import NO_CONTACT, ContactSettings, ContactSurface, FrictionlessContact, Multipliers
 from seadesign.fea.facing import FacingSurfaces
 from seadesign.fea.elements import element_mesh
@@ -143,6 +144,7 @@ def _state(p: PathProblem, u: np.ndarray, f: np.ndarray, theta: float, iteration
     return point, v
 
 
+@one_blas_thread
 def rotation_path(
     mesh: TetMesh,
     law: Hyperelastic,
@@ -265,6 +267,7 @@ def _predict(p: PathProblem, u: np.ndarray, v: np.ndarray, step: float,
     return u + swirl + rest * step
 
 
+@one_blas_thread
 def rotation_sweep(mesh: TetMesh, law: Hyperelastic, rotations_rad: list[float],
                    settings: PathSettings = PathSettings(), order: int = 2) -> tuple[PathPoint, ...]:
     """The equilibria at the hub rotations `rotations_rad` (rad) in the order given, from rest: loading, then
