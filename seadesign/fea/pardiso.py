@@ -7,7 +7,8 @@ run to run (a large-deflection path by 1e-13 Nm), and the explorer, which fits i
 digits, took another route on every run. MKL promises that only for a fixed number of threads, so it is
 also kept from choosing fewer threads when the machine is busy (MKL_DYNAMIC=FALSE unless the environment
 sets MKL_DYNAMIC; Intel's reproducibility conditions): a path through a creasing notch amplifies the last
-digits. Results may still depend on the number of threads.
+digits. On the matrices measured (to 81,000 unknowns in 3x3 blocks) 1 and 2 threads gave the same solutions to
+the last digit; NumPy's BLAS does not (`fea.blas`).
 
 Block storage matters: PARDISO then orders the node graph, nine times smaller than the
 scalar one (measured in docs/validation/linear-fea.md).
