@@ -4,7 +4,7 @@ NumPy's BLAS (OpenBLAS) splits a long dot product or norm over its threads and a
 depends on how many there are: on a 420,000-long vector, 1 and 2 threads differ by 3.5e-12 of 360. A path through
 a creasing notch amplifies such last digits into where it ends (6 x 8 mm's path mesh ended 15 mrad apart). A
 sweep's workers already run on one thread each; `one_blas_thread` gives any caller the same digits. MKL's PARDISO
-is left as it is: in its reproducible mode (`fea.pardiso`) its factors are the same on 1 and 2 threads.
+is left as it is: in its reproducible mode (`fea.pardiso`) its solutions are the same on 1 and 2 threads.
 """
 
 from __future__ import annotations
