@@ -126,7 +126,8 @@ def main() -> None:
                          strain_at(path, rotations[0]), path.time_s))
             _print_row(rows[-1], rows[0])  # as it comes: a long run leaves its coarse rows
             if args.contact:
-                through.add(candidate.name, c, f"{ld.dofs:,}", " / ".join(f"{v:.4g}" for v in rows[-1][2]),
+                through.add(candidate.name, c, f"{ld.dofs:,}",
+                            " / ".join(f"{v:.4g}" if np.isfinite(v) else "not reached" for v in rows[-1][2]),
                             *_contact_cells(path, ld, rotations[-1]))
                 print("    " + "; ".join(through.rows[-1][4:]), flush=True)
             if levels:
