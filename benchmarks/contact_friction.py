@@ -80,18 +80,19 @@ def main() -> None:
             runs[mu] = run_ccx_path(inp, emesh.nodes_m, theta)
     free, rough = runs[0.0], runs[args.friction]
     n = min(len(free.torque_Nm), len(rough.torque_Nm))
+    change = np.asarray(rough.torque_Nm[:n]) / np.asarray(free.torque_Nm[:n]) - 1  # friction's, relative
     table = Table(["rotation (rad)", "ours, frictionless (Nm)", "ours, through contact (Nm)",
                    "CalculiX, frictionless (Nm)", f"CalculiX, friction {args.friction:g} (Nm)", "friction's change"])
     for i in range(n):
         point = path.points[i + 1]
         table.add(f"{theta[i]:.4f}", f"{point.torque_Nm:.4f}", f"{point.contact.moment_Nm:.4f}",
                   f"{free.torque_Nm[i]:.4f}", f"{rough.torque_Nm[i]:.4f}",
-                  f"{rough.torque_Nm[i] / free.torque_Nm[i] - 1:+.1e}")
+                  f"{change[i]:+.1e}")
     event = path.events[0]
     at = np.flatnonzero(free.torque_Nm[:n] >= lc.stall_torque_Nm)
     i = int(at[0]) if len(at) else n - 1
     where = "the first rotation carrying the stall torque" if len(at) else "the last rotation both reached"
-    summary = (f"Friction {args.friction:g} changes the torque by {rough.torque_Nm[i] / free.torque_Nm[i] - 1:+.1e} "
+    summary = (f"Friction {args.friction:g} changes the torque by {change[i]:+.1e} "
                f"(relative) at {theta[i]:.4f} rad ({where}; stall torque {lc.stall_torque_Nm:g} Nm), where contact "
                f"carries {path.points[i + 1].contact.moment_Nm:.3g} Nm in our path. First contact at "
                f"{event.rotation_rad:.4f} rad, {event.torque_Nm:.3g} Nm; our path ends: {path.stop_reason} at "
