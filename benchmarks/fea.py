@@ -223,6 +223,11 @@ def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool, contact:
           + (f"; did not converge: {cc.failure}" if cc.failure else ""))
     print(f"torque: max |T_ccx / T_ours - 1| = {diff.max():.1e} over {n} rotations to {theta[n - 1]:.4f} rad "
           f"(at the last: {diff[-1]:.1e})")
+    touch = next((e.rotation_rad for e in path.events if e.kind == "contact"), None)
+    if touch is not None:
+        before = np.array(theta[:n]) < touch
+        print("".join(f"; {name}: {len(part)} rotations, max {part.max():.1e}" for name, part in
+                      (("before contact", diff[before]), ("through contact", diff[~before])) if len(part))[2:])
     print(f"ours (path total) / CalculiX = {path.time_s:.2f} / {cc.wall_s:.2f} = {path.time_s / cc.wall_s:.2f}")
 
 
