@@ -187,7 +187,7 @@ def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool, contact:
         path = rp.rotation_path(mesh, law, lc.stall_torque_Nm, settings)
     points = path.points[1:]
     its = np.array([p.iterations for p in points])
-    factorizations = sum(parts[name][1] for name in parts if name.startswith("factorization"))
+    factorizations = parts["factorization, ordering a new pattern"][1] + parts["factorization on the pattern ordered"][1]
     print(f"large-deflection path (neo-Hooke C10 {law.c10_Pa / 1e6:.3g} MPa, D1 {law.d1_per_Pa * 1e6:.3g} 1/MPa; "
           f"formulation full; to {lc.stall_torque_Nm:g} Nm or {max_rotation_rad:g} rad): stopped by {path.stop_reason} "
           f"at {path.stop_rotation_rad:.4f} rad, {path.stop_torque_Nm:.4g} Nm"
@@ -228,8 +228,8 @@ def path_benchmark(mesh, m, lc, max_rotation_rad: float, use_ccx: bool, contact:
     touch = next((e.rotation_rad for e in path.events if e.kind == "contact"), None)
     if touch is not None:
         before = np.array(theta[:n]) < touch
-        print("".join(f"; {name}: {len(part)} rotations, max {part.max():.1e}" for name, part in
-                      (("before contact", diff[before]), ("through contact", diff[~before])) if len(part))[2:])
+        print("; ".join(f"{name}: {len(part)} rotations, max {part.max():.1e}" for name, part in
+                        (("before contact", diff[before]), ("through contact", diff[~before])) if len(part)))
     print(f"ours (path total) / CalculiX = {path.time_s:.2f} / {cc.wall_s:.2f} = {path.time_s / cc.wall_s:.2f}")
 
 
