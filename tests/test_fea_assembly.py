@@ -12,7 +12,7 @@ from skfem import asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
 from seadesign.errors import SolverError
-from seadesign.fea.assembly import mass_upper, nodal_forces, stiffness_upper
+from seadesign.fea.assembly import add_pair_blocks, mass_upper, nodal_forces, stiffness_upper
 from seadesign.fea.couplings import couple
 from seadesign.fea.elements import element_mesh
 from seadesign.fea.linsolve import SPDFactorization, full_from_upper
@@ -35,6 +35,36 @@ def test_stiffness_equals_scikit_fem(small, order):
     ref = asm(linear_elasticity(*lame_parameters(E, NU)), basis).toarray()
     mine = ours[np.ix_(perm, perm)]
     assert np.abs(mine - ref).max() < 1e-9 * np.abs(ref).max()
+
+
+def test_pair_blocks_add_to_the_dense_matrix_and_join_the_pattern(small):
+    # symmetric 9 x 9 node groups (nodes repeated within a group, groups repeated, some nodes held, most pairs of
+    # nodes far apart and outside the stiffness's pattern) added to the stiffness, against dense addition
+    points, tets = small
+    emesh = element_mesh(points, tets, 2)
+    n = len(emesh.nodes_m)
+    rng = np.random.default_rng(3)
+    held = rng.choice(n, n // 10, replace=False)
+    index = np.full(n, -1)
+    free = np.setdiff1d(np.arange(n), held)
+    index[free] = np.arange(len(free))
+    upper = stiffness_upper(emesh, E, NU, index, len(free))
+    nodes = rng.integers(0, n, size=(40, 9))
+    nodes[5, 3] = nodes[5, 7]
+    nodes[6] = nodes[7]
+    half = rng.normal(size=(40, 27, 27))
+    blocks = (half + half.transpose(0, 2, 1)).reshape(40, 9, 3, 9, 3).transpose(0, 1, 3, 2, 4)
+    dense = full_from_upper(upper.matrix()).toarray()
+    for p in range(40):
+        for a in range(9):
+            for b in range(9):
+                i, j = index[nodes[p, a]], index[nodes[p, b]]
+                if i >= 0 and j >= 0:
+                    dense[3 * i:3 * i + 3, 3 * j:3 * j + 3] += blocks[p, a, b]
+    summed = add_pair_blocks(upper, index, nodes, blocks)
+    assert len(summed.rows) > len(upper.rows)
+    assert np.all(np.diff(summed.rows.astype(np.int64) * summed.n + summed.cols) > 0)  # sorted, each entry once
+    assert np.abs(full_from_upper(summed.matrix()).toarray() - dense).max() < 1e-12 * np.abs(dense).max()
 
 
 def test_patch_test_energy_and_interior_forces(small):

@@ -11,7 +11,7 @@ from helpers_contact import half_cylinder_on_flat, two_blocks
 from helpers_neo_hooke import neo_hooke_cauchy, uniaxial
 
 from seadesign.design.materials import Hyperelastic
-from seadesign.errors import ConfigError
+from seadesign.errors import ConfigError, NotPositiveDefinite
 from seadesign.fea.contact import ContactSettings, ContactSurface, FrictionlessContact, Multipliers
 from seadesign.fea.contact_geometry import plane_gap
 from seadesign.fea.elements import element_mesh, midside_nodes
@@ -233,18 +233,58 @@ def test_hertz_converges_on_refinement():
     assert abs(fine[0]) < abs(coarse[0]) and abs(fine[1]) < abs(coarse[1])
 
 
-def test_stability_is_judged_on_the_normal_stiffness_where_contact_presses():
-    """`Equilibrium.stability` refactors the tangent (solid and the contact's normal stiffness, positive definite
-    here) only where contact carries pressure; `factor` then gives the full tangent, whose solve is Newton's."""
-    system, u0, *_ = _blocks(2, 2, True)
-    apart = np.zeros_like(u0)
-    system.contact.assignment = system.contact.search(apart)
+def _dense_tangent(system: Equilibrium, u: np.ndarray, geometric: bool) -> np.ndarray:
+    """The free-node tangent at u as a dense matrix, column by column from `Equilibrium.tangent_product` (the
+    element-wise product, not the assembly that `factor` uses); without the contact's geometric part unless
+    `geometric`."""
+    n = 3 * len(system.free)
+    k = np.empty((n, n))
+    for j in range(n):
+        v = np.zeros_like(u)
+        v[system.free] = np.eye(1, n, j).reshape(-1, 3)
+        k[:, j] = system.residual(system.tangent_product(u, v))
+    if not geometric:
+        nodes, full = system.contact.tangent_blocks(u, True)
+        _, normal = system.contact.tangent_blocks(u, False)
+        rows = system.node_index[nodes]
+        for p, a, b in zip(*np.nonzero((rows[:, :, None] >= 0) & (rows[:, None, :] >= 0))):
+            i, j = 3 * rows[p, a], 3 * rows[p, b]
+            k[i:i + 3, j:j + 3] -= full[p, a, b] - normal[p, a, b]
+    return k
+
+
+def test_a_state_is_stable_where_its_tangent_or_the_one_with_the_normal_stiffness_only_is_positive_definite(monkeypatch):
+    """`Equilibrium.stable_factor`, against LAPACK's eigenvalues of the two tangents: at the pressed blocks' equilibrium
+    the tangent is positive definite, and one factorization judges; with a pressure a hundred times the shear
+    modulus the pressure's geometric part makes it indefinite (a crease), the tangent with the contact's normal
+    stiffness only stays positive definite, and the state is stable, with the full tangent factored again for the
+    path's direction; with the solid's tangent shifted below that one's smallest eigenvalue, both are indefinite
+    and the state is not stable."""
+    system, u0, *_ = _blocks(2, 2, False)  # the base deformable: its facets turn under the pressure
+    u = newton_augmented(system, u0).u
+    assert np.linalg.eigvalsh(_dense_tangent(system, u, True)).min() > 0
     before = system.factorizations
-    system.stability(apart)  # no pressure: nothing to judge beyond `factor`
-    assert system.factorizations == before
-    result = newton_augmented(system, u0)
+    assert system.stable_factor(u).inertia()[1] == 0 and system.factorizations == before + 1
+
+    contact = system.contact
+    keys = contact.assignment[0] * len(contact.surface.facets) + contact.assignment[1]
+    contact.multipliers = Multipliers(keys, np.full(len(keys), 100 * LAW.shear_modulus_Pa))
+    full, normal = (np.linalg.eigvalsh(_dense_tangent(system, u, geometric)) for geometric in (True, False))
+    assert full.min() < 0 < normal.min()
     before = system.factorizations
-    system.stability(result.u)
-    assert system.factorizations == before + 1 and system.pardiso.inertia()[1] == 0
-    full, normal = (system.contact.tangent_blocks(result.u, geometric) for geometric in (True, False))
-    assert np.abs(full[1] - normal[1]).max() > 0  # the pressure's geometric part is there, and left out
+    factors = system.stable_factor(u)
+    assert system.factorizations == before + 3 and factors.inertia()[1] == np.sum(full < 0)
+    v = np.random.default_rng(1).normal(size=3 * len(system.free))
+    x = factors.solve(v)
+    assert np.linalg.norm(_dense_tangent(system, u, True) @ x - v) < 1e-9 * np.linalg.norm(v)
+
+    tangent, shift = Solid.tangent, 1.01 * normal.min()
+
+    def shifted(solid, u, pattern):
+        k = tangent(solid, u, pattern)
+        k.values[k.rows == k.cols] -= shift * np.eye(3)
+        return k
+
+    monkeypatch.setattr(Solid, "tangent", shifted)
+    with pytest.raises(NotPositiveDefinite):
+        system.stable_factor(u)

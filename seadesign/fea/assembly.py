@@ -48,17 +48,21 @@ class UpperBlocks:
 
 def add_pair_blocks(upper: UpperBlocks, node_index: np.ndarray, nodes: np.ndarray, blocks: np.ndarray) -> UpperBlocks:
     """`upper` plus the blocks (P, q, q, d, d) of the dense q x q node groups `nodes` (P, q) (a contact pair's
-    coupling), mapped by node_index to block rows (-1: dropped); new entries join the sparsity pattern."""
+    coupling), mapped by node_index to block rows (-1: dropped); new entries join the sparsity pattern. The entries
+    are merged into `upper`'s sorted ones, never sorted again: the pairs add few entries to many."""
     r = node_index[nodes][:, :, None].repeat(nodes.shape[1], axis=2)
     c = np.swapaxes(r, 1, 2)
     keep = (r >= 0) & (c >= 0) & (r <= c)
-    d = blocks.shape[-1]
-    rows = np.concatenate([upper.rows, r[keep]])
-    cols = np.concatenate([upper.cols, c[keep]])
-    keys, inv = np.unique(rows.astype(np.int64) * upper.n + cols, return_inverse=True)
-    values = np.zeros((len(keys), d, d))
-    np.add.at(values, inv, np.concatenate([upper.values, blocks[keep]]))
-    return UpperBlocks(keys // upper.n, keys % upper.n, values, upper.n)
+    keys = r[keep].astype(np.int64) * upper.n + c[keep]
+    held = upper.rows.astype(np.int64) * upper.n + upper.cols
+    added = np.unique(keys)
+    at = np.searchsorted(held, added)
+    added = added[(at == len(held)) | (held[np.minimum(at, len(held) - 1)] != added)]
+    at = np.searchsorted(held, added)
+    merged = np.insert(held, at, added)
+    values = np.insert(upper.values, at, 0.0, axis=0)
+    np.add.at(values, np.searchsorted(merged, keys), blocks[keep])
+    return UpperBlocks(merged // upper.n, merged % upper.n, values, upper.n)
 
 
 @dataclass(frozen=True)

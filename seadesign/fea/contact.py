@@ -298,7 +298,7 @@ class FrictionlessContact:
         (and its factorization's ordering) holds while the assignment does.
 
         Without the geometric part the blocks are positive semi-definite: the tangent on which the path judges
-        the part's stability (`Equilibrium.stability`). On flat facets that part grows as the pressure over
+        the part's stability (`Equilibrium.stable_factor`). On flat facets that part grows as the pressure over
         the facet's size (a facet's rotation turns its force); where a notch's flanks press together beyond
         about the shear modulus it makes the tangent indefinite: the crease, a local surface instability of
         the compressed rubber that is not a loss of the spring's load path."""

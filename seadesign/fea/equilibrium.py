@@ -75,25 +75,28 @@ class Equilibrium:
     def factor(self, u: np.ndarray) -> Pardiso:
         """LDL^T factorization of the free-node tangent at u; NotPositiveDefinite when its inertia counts a
         negative eigenvalue (the state has lost stability) and no contact carries pressure: with contact the
-        consistent tangent may be indefinite at a crease, and `stability` judges. The inertia is exact, where a
+        consistent tangent may be indefinite at a crease, and `stable_factor` judges. The inertia is exact, where a
         Cholesky factorization near a singular point may or may not meet its negative pivot."""
         pressed = self._factor(u, geometric=True)
         if not pressed and self.pardiso.inertia()[1] > 0:
             raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
         return self.pardiso
 
-    def stability(self, u: np.ndarray) -> None:
-        """NotPositiveDefinite unless the tangent at u is positive definite, the contact counted by its normal
-        stiffness only (see `FrictionlessContact.tangent_blocks`): buckling of the part with its contacts as
-        constraints. Refactors only when contact carries pressure (else `factor` has judged); call `factor` after."""
-        if self._pressed(u):
+    def stable_factor(self, u: np.ndarray) -> Pardiso:
+        """`factor` at a converged state u, which must be stable: NotPositiveDefinite when the tangent (the energy's
+        Hessian) has a negative eigenvalue and, where contact carries pressure, so has the tangent with the
+        contact's normal stiffness only (see `FrictionlessContact.tangent_blocks`: buckling of the part with its
+        contacts as constraints, where the pressure's geometric part alone would count a crease). A positive
+        definite tangent is a strict minimum of the energy, stable whatever the contact; only where it is not does
+        the second tangent judge, and the tangent is factored again for the path's direction."""
+        pressed = self._factor(u, geometric=True)
+        if self.pardiso.inertia()[1] == 0:
+            return self.pardiso
+        if pressed:
             self._factor(u, geometric=False)
-            if self.pardiso.inertia()[1] > 0:
-                raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
-
-    def _pressed(self, u: np.ndarray) -> bool:
-        """Whether contact carries pressure at u."""
-        return self.contact is not None and len(self.contact.active(u)) > 0
+        if not pressed or self.pardiso.inertia()[1] > 0:
+            raise NotPositiveDefinite("the tangent stiffness has a negative eigenvalue")
+        return self.factor(u)
 
     def _factor(self, u: np.ndarray, geometric: bool) -> bool:
         """Factor the tangent at u (the contact's geometric part if `geometric`); whether contact presses there

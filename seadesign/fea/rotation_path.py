@@ -127,8 +127,7 @@ def _state(p: PathProblem, u: np.ndarray, f: np.ndarray, theta: float, iteration
            norms: list[float]) -> tuple[PathPoint, np.ndarray]:
     """The converged point at u (internal forces f) and the path's direction du/dtheta there, from the
     tangent factored at u (NotPositiveDefinite: unstable); the next increment's Newton starts with it."""
-    p.system.stability(u)
-    fac = p.system.factor(u)
+    fac = p.system.stable_factor(u)
     v = np.zeros_like(u)
     v[p.drive.hub] = p.drive.velocity(theta)
     v[p.system.free] = -fac.solve(p.system.residual(p.system.tangent_product(u, v))).reshape(-1, 3)
